@@ -1,0 +1,57 @@
+//! The command-line layer: argument parsing (clap) and one file per subcommand. The binary is
+//! thin; every subcommand calls into the library.
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+pub mod check;
+pub mod events;
+pub mod export;
+pub mod fit;
+pub mod generate;
+
+/// gaitfit: fit the published gait relations of KLAW (1989), RUNNER (1996) and Ko–Badler
+/// (1993) to measured data, generate walking and running with the fitted coefficients, and
+/// report residuals.
+#[derive(Debug, Parser)]
+#[command(name = "gaitfit", version, about, long_about = None, propagate_version = true)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Refit the published relations on trial tables (or raw measured files) and write fits/ and
+    /// reports/.
+    Fit(fit::Args),
+    /// Check committed fits against an r² bar (exit 1 and say which fit is below it).
+    Check(check::Args),
+    /// Export fitted coefficient tables for other programs (Rust, JSON, TOML, CSV).
+    Export(export::Args),
+    /// Detect gait events in measured files and write per-step tables.
+    Events(events::Args),
+    /// Generate motion (running, walking, or a generalized measured walk).
+    Generate(generate::Args),
+}
+
+/// Runs the command line; returns the process exit code (0 success, 1 check failed or error,
+/// 2 usage error).
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Fit(a) => fit::run(a),
+        Command::Check(a) => check::run(a),
+        Command::Export(a) => export::run(a),
+        Command::Events(a) => events::run(a),
+        Command::Generate(a) => generate::run(a),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("gaitfit: error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

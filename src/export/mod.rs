@@ -1,0 +1,19 @@
+//! Writers: coefficient tables (JSON, TOML, Rust, CSV) and motion files (BVH, CSV, TRC).
+use thiserror::Error;
+
+/// Errors of the export layer.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum ExportError {
+    /// Writing a file failed.
+    #[error(transparent)]
+    Fs(#[from] crate::fsio::FsError),
+    /// The content cannot be written in the requested format.
+    #[error("{path}: {message}")]
+    Format {
+        /// The destination.
+        path: String,
+        /// Why.
+        message: String,
+    },
+}

@@ -1,0 +1,30 @@
+//! Motion generators and the figure they animate: one skeleton and one [`motion::Motion`] type
+//! shared by the running (RUNNER), walking (KLAW) and generalization (Ko–Badler) generators.
+pub mod motion;
+pub mod skeleton;
+
+use thiserror::Error;
+
+/// Errors of the generators.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum GenerateError {
+    /// A parameter is outside its anatomical or numerical limits.
+    #[error("parameter {name} = {value}: {message}")]
+    Parameter {
+        /// Parameter or attribute name.
+        name: String,
+        /// The value given.
+        value: f64,
+        /// The accepted range and why.
+        message: String,
+    },
+    /// A numerical procedure (shooting, Newton–Raphson, IK) failed.
+    #[error("{stage}: {message}")]
+    Numerical {
+        /// Which stage (e.g. "step 3, swing2 shooting").
+        stage: String,
+        /// Details.
+        message: String,
+    },
+}

@@ -1,0 +1,1 @@
+//! The [`Motion`] type shared by every generator.

@@ -1,0 +1,1 @@
+//! The figure: skeleton and anthropometry scaled from body height.
