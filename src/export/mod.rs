@@ -1,4 +1,9 @@
 //! Writers: coefficient tables (JSON, TOML, Rust, CSV) and motion files (BVH, CSV, TRC).
+pub mod bvh;
+pub mod motion;
+pub mod motion_csv;
+pub mod trc;
+
 use thiserror::Error;
 
 /// Errors of the export layer.

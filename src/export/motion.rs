@@ -1,0 +1,56 @@
+//! One entry point for writing a [`Motion`]: the format follows the file extension.
+use super::ExportError;
+use crate::generator::motion::Motion;
+use std::path::Path;
+
+/// The motion file formats gaitfit writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionFormat {
+    /// Biovision hierarchy (`.bvh`), see [`super::bvh`].
+    Bvh,
+    /// Landmarks, contacts and joint angles (`.csv`) plus `<stem>_events.csv`, see
+    /// [`super::motion_csv`].
+    Csv,
+    /// OpenSim marker file (`.trc`), see [`super::trc`].
+    Trc,
+}
+
+impl MotionFormat {
+    /// The format of `path` from its extension (case-insensitive), or an error naming the path
+    /// and the accepted extensions.
+    pub fn from_path(path: &Path) -> Result<MotionFormat, ExportError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        match ext.as_str() {
+            "bvh" => Ok(MotionFormat::Bvh),
+            "csv" => Ok(MotionFormat::Csv),
+            "trc" => Ok(MotionFormat::Trc),
+            _ => {
+                Err(ExportError::Format {
+                    path: path.display().to_string(),
+                    message: format!(
+                    "unknown motion file extension {:?}: use .bvh (Blender and other animation \
+                     tools), .csv (landmarks, contacts and joint angles; events go to \
+                     <stem>_events.csv) or .trc (OpenSim markers)",
+                    if ext.is_empty() { "(none)".to_string() } else { format!(".{ext}") }
+                ),
+                })
+            }
+        }
+    }
+}
+
+/// Writes `motion` to `path` in the format its extension names (`.bvh`, `.csv`, `.trc`); a CSV
+/// also writes its events to `<stem>_events.csv` next to it. Files are written atomically.
+pub fn write(motion: &Motion, path: &Path) -> Result<(), ExportError> {
+    match MotionFormat::from_path(path)? {
+        MotionFormat::Bvh => super::bvh::write(motion, path, &super::bvh::BvhOptions::default()),
+        MotionFormat::Csv => {
+            super::motion_csv::write(motion, path)?;
+            super::motion_csv::write_events(motion, &super::motion_csv::events_path(path))
+        }
+        MotionFormat::Trc => super::trc::write(motion, path, &super::trc::TrcOptions::default()),
+    }
+}

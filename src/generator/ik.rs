@@ -1,0 +1,187 @@
+//! Inverse kinematics helpers shared by the generators: the two-link (thigh–shank) leg, placing a
+//! foot by one of its sole points, and setting a segment's world orientation.
+//!
+//! Conventions are those of [`super::skeleton`]: the knee is a hinge about the thigh's local z
+//! axis with flexion negative, so the knee always points along the thigh frame's +x.
+use super::skeleton::{FootPoint, Joint, Pose, Skeleton};
+use crate::events::Side;
+use glam::{DMat3, DQuat, DVec3};
+
+/// Solution of a two-link chain (e.g. hip → knee → ankle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TwoLink {
+    /// Position of the middle joint (knee), m.
+    pub middle: DVec3,
+    /// Position actually reached by the end (equals the target when `reached`), m.
+    pub end: DVec3,
+    /// False when the target was out of reach (too far or too close) and was clamped onto the
+    /// reachable shell along the same direction.
+    pub reached: bool,
+    /// Flexion of the middle joint, rad, ≥ 0 (0 = straight chain).
+    pub flexion: f64,
+}
+
+/// Places the middle joint of a chain `root → middle → end` with segment lengths `upper` and
+/// `lower` so that the end reaches `target`, the chain bending toward `pole` (a direction: the
+/// knee points to the side of the root–target line where `pole` points). Targets out of reach are
+/// clamped to the nearest reachable distance along the root–target direction.
+///
+/// If `pole` is parallel to the root–target line, the world +x (then +z) is used instead.
+pub fn two_link(root: DVec3, target: DVec3, upper: f64, lower: f64, pole: DVec3) -> TwoLink {
+    let to = target - root;
+    let d_raw = to.length();
+    let e = if d_raw > 1e-12 {
+        to / d_raw
+    } else {
+        DVec3::NEG_Y
+    };
+    let d_min = (upper - lower).abs() + 1e-9;
+    let d_max = upper + lower;
+    let d = d_raw.clamp(d_min, d_max);
+    let reached = (d - d_raw).abs() <= 1e-9;
+    let mut p = pole - e * pole.dot(e);
+    if p.length_squared() < 1e-18 {
+        p = DVec3::X - e * e.x;
+        if p.length_squared() < 1e-18 {
+            p = DVec3::Z - e * e.z;
+        }
+    }
+    let p = p.normalize();
+    // Law of cosines: angle at the root between the upper segment and the root–end line.
+    let cos_a = ((upper * upper + d * d - lower * lower) / (2.0 * upper * d)).clamp(-1.0, 1.0);
+    let sin_a = (1.0 - cos_a * cos_a).sqrt();
+    let middle = root + upper * (cos_a * e + sin_a * p);
+    let cos_k = ((upper * upper + lower * lower - d * d) / (2.0 * upper * lower)).clamp(-1.0, 1.0);
+    TwoLink {
+        middle,
+        end: root + d * e,
+        reached,
+        flexion: std::f64::consts::PI - cos_k.acos(),
+    }
+}
+
+/// Result of [`leg_ik`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegIk {
+    /// True when the ankle reached its target exactly.
+    pub reached: bool,
+    /// Distance between the target and the ankle actually reached, m.
+    pub residual_m: f64,
+    /// Knee flexion, rad, ≥ 0 (the knee's z angle is its negative).
+    pub knee_flexion: f64,
+}
+
+/// Sets the hip (3 DOF) and knee (hinge) rotations of `side` in `pose` so that the ankle joint
+/// centre is at `ankle_target` (world), with the knee pointing toward `knee_direction` (world; for
+/// a forward-walking figure usually the pelvis's forward axis, or a point direction chosen to
+/// control hip rotation). Uses the pose's current root and pelvis rotation; leaves the ankle's
+/// local rotation unchanged (set the foot afterwards, e.g. with [`Pose::set_world_rotation`]).
+pub fn leg_ik(
+    skeleton: &Skeleton,
+    pose: &mut Pose,
+    side: Side,
+    ankle_target: DVec3,
+    knee_direction: DVec3,
+) -> LegIk {
+    let [hip, knee, _, _] = Joint::leg(side);
+    let a = skeleton.anthropometry();
+    let pelvis = pose.rotations[Joint::Pelvis.index()];
+    let hip_pos = pose.root + pelvis * skeleton.offset(hip);
+    let sol = two_link(
+        hip_pos,
+        ankle_target,
+        a.thigh.length_m,
+        a.shank.length_m,
+        knee_direction,
+    );
+    // Thigh frame in world: −y along the thigh, +x toward where the knee points.
+    let down = (sol.middle - hip_pos).normalize();
+    let y_axis = -down;
+    let toward_end = (sol.end - hip_pos).normalize();
+    // The knee bulges away from the hip–ankle line; its forward direction is the component of
+    // that bulge orthogonal to the thigh.
+    let bulge = sol.middle - (hip_pos + toward_end * toward_end.dot(sol.middle - hip_pos));
+    let mut x_axis = bulge - y_axis * bulge.dot(y_axis);
+    if x_axis.length_squared() < 1e-18 {
+        // Straight leg: take the knee direction.
+        x_axis = knee_direction - y_axis * knee_direction.dot(y_axis);
+        if x_axis.length_squared() < 1e-18 {
+            x_axis = pelvis * DVec3::X;
+            x_axis -= y_axis * x_axis.dot(y_axis);
+        }
+    }
+    let x_axis = x_axis.normalize();
+    let z_axis = x_axis.cross(y_axis);
+    let thigh_world = DQuat::from_mat3(&DMat3::from_cols(x_axis, y_axis, z_axis)).normalize();
+    pose.rotations[hip.index()] = (pelvis.inverse() * thigh_world).normalize();
+    pose.rotations[knee.index()] = DQuat::from_rotation_z(-sol.flexion);
+    LegIk {
+        reached: sol.reached,
+        residual_m: (ankle_target - sol.end).length(),
+        knee_flexion: sol.flexion,
+    }
+}
+
+/// World position of the ankle joint centre that puts the foot sole point `pivot` at
+/// `pivot_world` when the foot (ankle segment) has world orientation `foot_world` and the
+/// metatarsal joint the local rotation `metatarsal` — e.g. the stance ankle while the foot rolls
+/// about a fixed heel, ball or toe.
+pub fn ankle_for_foot_point(
+    skeleton: &Skeleton,
+    side: Side,
+    pivot: FootPoint,
+    pivot_world: DVec3,
+    foot_world: DQuat,
+    metatarsal: DQuat,
+) -> DVec3 {
+    pivot_world - foot_world * skeleton.foot_point_offset(side, pivot, metatarsal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generator::skeleton::Landmark;
+
+    #[test]
+    fn two_link_reaches_and_respects_lengths() {
+        let s = two_link(
+            DVec3::ZERO,
+            DVec3::new(0.2, -0.7, 0.05),
+            0.45,
+            0.43,
+            DVec3::X,
+        );
+        assert!(s.reached);
+        assert!(((s.middle).length() - 0.45).abs() < 1e-12);
+        assert!(((s.end - s.middle).length() - 0.43).abs() < 1e-12);
+        assert!(s.middle.x > 0.1); // bends toward +x
+        let far = two_link(
+            DVec3::ZERO,
+            DVec3::new(0.0, -2.0, 0.0),
+            0.45,
+            0.43,
+            DVec3::X,
+        );
+        assert!(!far.reached && far.flexion.abs() < 1e-6);
+    }
+
+    #[test]
+    fn leg_ik_places_the_ankle_and_points_the_knee_forward() {
+        let sk = Skeleton::from_height(1.8, 75.0).unwrap();
+        let mut pose = sk.rest_pose();
+        pose.set_euler(
+            Joint::Pelvis,
+            crate::generator::skeleton::Euler::new(0.05, 0.04, 0.2),
+        );
+        let target = DVec3::new(0.25, 0.2, 0.12);
+        let r = leg_ik(&sk, &mut pose, Side::Right, target, DVec3::X);
+        assert!(r.reached);
+        let lm = sk.landmarks(&pose);
+        assert!((lm[Landmark::RAnkle.index()] - target).length() < 1e-9);
+        let knee = lm[Landmark::RKnee.index()];
+        let hip = lm[Landmark::RHip.index()];
+        let mid = 0.5 * (hip + target);
+        assert!((knee - mid).x > 0.0);
+        assert!(pose.euler(Joint::RKnee).z < 0.0);
+    }
+}
