@@ -188,7 +188,7 @@ impl Motion {
     }
 
     /// Euler angles (Z–X–Y convention of [`super::skeleton`]) of every joint in frame `i`,
-    /// degrees, `[z, x, y]` per joint, indexed by [`Joint`]; the pelvis's are its world
+    /// degrees, `[z, x, y]` per joint, indexed by [`super::skeleton::Joint`]; the pelvis's are its world
     /// orientation. Each angle is in (−180°, 180°]; see [`Motion::joint_angle_series_deg`] for
     /// curves unwrapped across frames.
     pub fn joint_angles_deg(&self, i: usize) -> [[f64; 3]; JOINT_COUNT] {
