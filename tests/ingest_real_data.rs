@@ -1,0 +1,193 @@
+//! The readers on the real shared data sets (`../shared/data`), checked against facts stated by
+//! the data sets' documentation (`../shared/data/README.md`, `hamner2013/README.md`) or read off
+//! the files by hand (first rows, headers).
+use gaitfit::events::Side;
+use gaitfit::ingest::types::{Axis, Setting, Trial};
+use gaitfit::ingest::{mot, read_trial, ReadOptions};
+use gaitfit::shared_data::require;
+
+fn read(rel: &str) -> Trial {
+    let p = require(rel);
+    match read_trial(&p, &ReadOptions::default()) {
+        Ok(t) => t,
+        Err(e) => panic!("{rel}: {e}"),
+    }
+}
+
+fn y_up_x_forward(t: &Trial) {
+    let f = t
+        .frame
+        .as_ref()
+        .unwrap_or_else(|| panic!("{}: no frame: {:?}", t.name, t.notes));
+    assert_eq!(
+        (f.vertical, f.forward, f.forward_sign),
+        (Axis::Y, Axis::X, 1.0),
+        "{}",
+        f.how
+    );
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn winter_table_a1() {
+    let t = read("bmclab/WinterTableA1.txt");
+    let m = t.markers.as_ref().unwrap();
+    assert_eq!(m.len(), 106);
+    assert_eq!(m.rate_hz, 69.9);
+    assert_eq!(m.names.len(), 8);
+    y_up_x_forward(&t);
+    // Frame 1 rib cage (46.98, 104.41) cm (first data row of the table).
+    let rib = m.get("RIB CAGE").unwrap();
+    assert!((rib[0][0] - 0.4698).abs() < 1e-12 && (rib[0][1] - 1.0441).abs() < 1e-12);
+    // Right heel strikes near frames 28 and 97 (README): the heel is lowest there.
+    let heel = m.get("RIGHT HEEL").unwrap();
+    let lowest = |a: usize, b: usize| {
+        (a..=b)
+            .min_by(|&i, &j| heel[i - 1][1].total_cmp(&heel[j - 1][1]))
+            .unwrap()
+    };
+    assert_eq!(lowest(20, 40), 28);
+    assert_eq!(lowest(85, 106), 97);
+    // Stride ≈ 1.41 m, speed ≈ 1.43 m/s (README).
+    let stride = heel[96][0] - heel[27][0];
+    assert!((stride - 1.41).abs() < 0.02, "stride {stride}");
+    let speed = stride / (m.time_s[96] - m.time_s[27]);
+    assert!((speed - 1.43).abs() < 0.03, "speed {speed}");
+    assert!(t.subject.body_height_m.is_none());
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn winter_wn35b_is_in_metres_and_matches_table_a1() {
+    let raw = read("bmclab/WinterTableA1.txt");
+    let t = read("bmclab/wn35b.txt");
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("header says cm") && n.contains("in m")),
+        "{:?}",
+        t.notes
+    );
+    let (a, b) = (raw.markers.unwrap(), t.markers.unwrap());
+    assert_eq!(b.len(), 106);
+    assert_eq!(a.names, b.names);
+    // Filtered vs raw: same landmarks within a few cm in every frame.
+    for (ta, tb) in a.positions.iter().zip(&b.positions) {
+        for (pa, pb) in ta.iter().zip(tb) {
+            assert!((pa[0] - pb[0]).abs() < 0.03 && (pa[1] - pb[1]).abs() < 0.03);
+        }
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn bmclab_walk_trc_with_forces() {
+    let t = read("bmclab/walk1.trc");
+    let m = t.markers.as_ref().unwrap();
+    assert_eq!((m.rate_hz, m.names.len(), m.len()), (150.0, 28, 364));
+    y_up_x_forward(&t);
+    assert_eq!(t.setting, Setting::Overground);
+    // First data row, R.ASIS = (-148.01762, 1039.82568, -479.70297) mm.
+    let asis = m.get("R.ASIS").unwrap()[0];
+    assert!((asis[0] + 0.14801762).abs() < 1e-12 && (asis[1] - 1.03982568).abs() < 1e-12);
+    // walk1.forces: 7 plates at 450 Hz, 1092 samples, same duration as the markers.
+    assert_eq!(t.plates.len(), 7);
+    for p in &t.plates {
+        assert_eq!((p.rate_hz, p.time_s.len()), (450.0, 1092));
+    }
+    let loaded: Vec<&str> = t
+        .plates
+        .iter()
+        .filter(|p| p.force_n.iter().any(|f| f[1] > 100.0))
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(loaded, ["FP3", "FP4", "FP5", "FP6"]);
+    // Peak vertical force of a walking step: 1–1.4 body weights of a ~60–90 kg adult.
+    let peak = t
+        .plates
+        .iter()
+        .flat_map(|p| p.force_n.iter().map(|f| f[1]))
+        .fold(0.0, f64::max);
+    assert!((600.0..1300.0).contains(&peak), "peak {peak}");
+    for (rel, frames) in [("bmclab/walk.trc", 184), ("bmclab/walk2.trc", 251)] {
+        let t = read(rel);
+        let m = t.markers.as_ref().unwrap();
+        assert_eq!((m.names.len(), m.len()), (28, frames), "{rel}");
+        y_up_x_forward(&t);
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn bmclab_running_trial() {
+    let t = read("bmclab/motion_capture_run.trc");
+    let m = t.markers.as_ref().unwrap();
+    assert_eq!((m.rate_hz, m.names.len(), m.len()), (150.0, 78, 123));
+    y_up_x_forward(&t);
+    let g = read("bmclab/grf_run.mot");
+    assert_eq!(g.plates.len(), 2);
+    assert_eq!(g.plates[0].side, Some(Side::Right));
+    assert_eq!(g.plates[1].side, Some(Side::Left));
+    assert_eq!(g.plates[0].rate_hz, 300.0);
+    assert_eq!(g.plates[0].time_s.len(), 246);
+    y_up_x_forward(&g);
+    // Real flight phases: samples where neither foot is loaded, between stances.
+    let n = g.plates[0].force_n.len();
+    let flight = (0..n)
+        .filter(|&i| g.plates.iter().all(|p| p.force_n[i][1] < 20.0))
+        .count();
+    assert!(flight > 20, "{flight} flight samples");
+    let ik = mot::read_table(&require("bmclab/ik_output_run.mot")).unwrap();
+    assert_eq!(ik.time_s.len(), 122);
+    assert_eq!(ik.names.len(), 39);
+    assert_eq!(ik.in_degrees, Some(true));
+    // First row: knee_angle_r = 18.53939731° (converted to radians).
+    let k = ik.column("knee_angle_r").unwrap()[0];
+    assert!((k - 18.53939731f64.to_radians()).abs() < 1e-12);
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn hamner_running_grf_and_subjects() {
+    let masses = [
+        ("subject01", 72.84, 1000.0),
+        ("subject02", 76.48, 960.0),
+        ("subject03", 64.00, 2000.0),
+        ("subject04", 80.47, 2000.0),
+        ("subject08", 82.37, 1000.0),
+    ];
+    for (s, mass, rate) in masses {
+        for v in 2..=5 {
+            let rel = format!("hamner2013/{s}/Run_{v}_grf.mot");
+            let t = read(&rel);
+            assert_eq!(
+                t.setting,
+                Setting::Treadmill {
+                    belt_speed_m_per_s: v as f64
+                },
+                "{rel}"
+            );
+            assert_eq!(t.gait, Some(gaitfit::events::Gait::Run));
+            assert_eq!(t.subject.mass_kg, Some(mass), "{rel}");
+            assert_eq!(t.plates.len(), 2);
+            assert_eq!(t.plates[0].side, Some(Side::Right));
+            assert_eq!(t.plates[1].side, Some(Side::Left));
+            assert_eq!(t.plates[0].rate_hz, rate, "{rel}");
+            y_up_x_forward(&t);
+            let leg = t.subject.leg_length_m.unwrap();
+            assert!((0.85..1.10).contains(&leg), "{rel}: leg {leg}");
+            let h = t.subject.body_height_m.unwrap();
+            assert!((1.6..2.0).contains(&h), "{rel}: height {h}");
+        }
+    }
+    // subject01's running markers and static trial.
+    let t = read("hamner2013/subject01/Run_3.trc");
+    let m = t.markers.as_ref().unwrap();
+    assert_eq!((m.rate_hz, m.names.len(), m.len()), (100.0, 42, 475));
+    assert_eq!(m.time_s[0], 0.05);
+    assert_eq!(t.plates.len(), 2, "Run_3_grf.mot read as companion");
+    y_up_x_forward(&t);
+    let s = read("hamner2013/subject01/static.trc");
+    assert_eq!(s.markers.as_ref().unwrap().names.len(), 64);
+    assert_eq!(s.markers.as_ref().unwrap().len(), 397);
+}
