@@ -60,65 +60,122 @@ pub fn two_link(root: DVec3, target: DVec3, upper: f64, lower: f64, pole: DVec3)
     }
 }
 
-/// Result of [`leg_ik`].
+/// Result of [`leg_ik`] and [`arm_ik`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LegIk {
-    /// True when the ankle reached its target exactly.
+pub struct LimbIk {
+    /// True when the end joint reached its target exactly.
     pub reached: bool,
-    /// Distance between the target and the ankle actually reached, m.
+    /// Distance between the target and the end joint actually reached, m.
     pub residual_m: f64,
-    /// Knee flexion, rad, ≥ 0 (the knee's z angle is its negative).
-    pub knee_flexion: f64,
+    /// Flexion of the middle joint (knee or elbow), rad, ≥ 0. The knee's z angle is its
+    /// negative, the elbow's z angle is equal to it.
+    pub flexion: f64,
 }
+
+/// Former name of [`LimbIk`].
+pub type LegIk = LimbIk;
 
 /// Sets the hip (3 DOF) and knee (hinge) rotations of `side` in `pose` so that the ankle joint
 /// centre is at `ankle_target` (world), with the knee pointing toward `knee_direction` (world; for
-/// a forward-walking figure usually the pelvis's forward axis, or a point direction chosen to
-/// control hip rotation). Uses the pose's current root and pelvis rotation; leaves the ankle's
-/// local rotation unchanged (set the foot afterwards, e.g. with [`Pose::set_world_rotation`]).
+/// a forward-walking figure usually the pelvis's forward axis, turned to control hip rotation).
+/// Uses the pose's current root and pelvis rotation; leaves the ankle's local rotation unchanged
+/// (set the foot afterwards, e.g. with [`Pose::set_world_rotation`]). Out-of-reach targets are
+/// clamped (straight leg toward the target) and reported with `reached = false`.
 pub fn leg_ik(
     skeleton: &Skeleton,
     pose: &mut Pose,
     side: Side,
     ankle_target: DVec3,
     knee_direction: DVec3,
-) -> LegIk {
+) -> LimbIk {
     let [hip, knee, _, _] = Joint::leg(side);
     let a = skeleton.anthropometry();
-    let pelvis = pose.rotations[Joint::Pelvis.index()];
-    let hip_pos = pose.root + pelvis * skeleton.offset(hip);
-    let sol = two_link(
-        hip_pos,
+    let (l1, l2) = (a.thigh.length_m, a.shank.length_m);
+    chain_ik(
+        skeleton,
+        pose,
+        hip,
+        knee,
+        l1,
+        l2,
         ankle_target,
-        a.thigh.length_m,
-        a.shank.length_m,
         knee_direction,
-    );
-    // Thigh frame in world: −y along the thigh, +x toward where the knee points.
-    let down = (sol.middle - hip_pos).normalize();
-    let y_axis = -down;
-    let toward_end = (sol.end - hip_pos).normalize();
-    // The knee bulges away from the hip–ankle line; its forward direction is the component of
-    // that bulge orthogonal to the thigh.
-    let bulge = sol.middle - (hip_pos + toward_end * toward_end.dot(sol.middle - hip_pos));
+        1.0,
+    )
+}
+
+/// Sets the shoulder (3 DOF) and elbow (hinge) rotations of `side` so that the wrist joint centre
+/// is at `wrist_target` (world), the elbow pointing toward `elbow_direction` (world; usually
+/// backward and slightly outward). Uses the current rotations of the pelvis, spine and clavicle.
+pub fn arm_ik(
+    skeleton: &Skeleton,
+    pose: &mut Pose,
+    side: Side,
+    wrist_target: DVec3,
+    elbow_direction: DVec3,
+) -> LimbIk {
+    let [_, shoulder, elbow, _] = Joint::arm(side);
+    let a = skeleton.anthropometry();
+    let (l1, l2) = (a.upper_arm.length_m, a.forearm.length_m);
+    chain_ik(
+        skeleton,
+        pose,
+        shoulder,
+        elbow,
+        l1,
+        l2,
+        wrist_target,
+        elbow_direction,
+        -1.0,
+    )
+}
+
+/// Two-link IK on `upper → middle → end`, both segments hanging along −y at rest and the middle
+/// joint a hinge about z. `bend = 1` for a knee (bulges toward local +x, flexion negative z),
+/// `−1` for an elbow (bulges toward local −x, flexion positive z).
+#[allow(clippy::too_many_arguments)]
+fn chain_ik(
+    skeleton: &Skeleton,
+    pose: &mut Pose,
+    upper: Joint,
+    middle: Joint,
+    l1: f64,
+    l2: f64,
+    target: DVec3,
+    pole: DVec3,
+    bend: f64,
+) -> LimbIk {
+    let (parent_rot, root_pos) = match upper.parent() {
+        Some(p) => {
+            let (rot, pos) = skeleton.joint_world(pose, p);
+            (rot, pos + rot * skeleton.offset(upper))
+        }
+        None => (DQuat::IDENTITY, pose.root),
+    };
+    let sol = two_link(root_pos, target, l1, l2, pole);
+    // Segment frame in world: −y along the upper segment; the middle joint's bulge (away from
+    // the root–end line, orthogonal to the segment) is local +x·bend.
+    let y_axis = -(sol.middle - root_pos).normalize();
+    let toward_end = (sol.end - root_pos).normalize();
+    let bulge = sol.middle - (root_pos + toward_end * toward_end.dot(sol.middle - root_pos));
     let mut x_axis = bulge - y_axis * bulge.dot(y_axis);
     if x_axis.length_squared() < 1e-18 {
-        // Straight leg: take the knee direction.
-        x_axis = knee_direction - y_axis * knee_direction.dot(y_axis);
+        // Straight limb: the bulge direction is the pole.
+        x_axis = pole - y_axis * pole.dot(y_axis);
         if x_axis.length_squared() < 1e-18 {
-            x_axis = pelvis * DVec3::X;
+            x_axis = parent_rot * DVec3::X;
             x_axis -= y_axis * x_axis.dot(y_axis);
         }
     }
-    let x_axis = x_axis.normalize();
+    let x_axis = bend * x_axis.normalize();
     let z_axis = x_axis.cross(y_axis);
-    let thigh_world = DQuat::from_mat3(&DMat3::from_cols(x_axis, y_axis, z_axis)).normalize();
-    pose.rotations[hip.index()] = (pelvis.inverse() * thigh_world).normalize();
-    pose.rotations[knee.index()] = DQuat::from_rotation_z(-sol.flexion);
-    LegIk {
+    let world = DQuat::from_mat3(&DMat3::from_cols(x_axis, y_axis, z_axis)).normalize();
+    pose.rotations[upper.index()] = (parent_rot.inverse() * world).normalize();
+    pose.rotations[middle.index()] = DQuat::from_rotation_z(-bend * sol.flexion);
+    LimbIk {
         reached: sol.reached,
-        residual_m: (ankle_target - sol.end).length(),
-        knee_flexion: sol.flexion,
+        residual_m: (target - sol.end).length(),
+        flexion: sol.flexion,
     }
 }
 
@@ -183,5 +240,25 @@ mod tests {
         let mid = 0.5 * (hip + target);
         assert!((knee - mid).x > 0.0);
         assert!(pose.euler(Joint::RKnee).z < 0.0);
+    }
+
+    #[test]
+    fn arm_ik_places_the_wrist_and_flexes_the_elbow_positively() {
+        let sk = Skeleton::from_height(1.7, 60.0).unwrap();
+        let mut pose = sk.rest_pose();
+        pose.set_euler(
+            Joint::Lumbar,
+            crate::generator::skeleton::Euler::new(-0.1, 0.05, 0.1),
+        );
+        let sh = sk.landmarks(&pose)[Landmark::LShoulder.index()];
+        let target = sh + DVec3::new(0.2, -0.3, 0.05);
+        let r = arm_ik(&sk, &mut pose, Side::Left, target, -DVec3::X);
+        assert!(r.reached && r.flexion > 0.0);
+        let lm = sk.landmarks(&pose);
+        assert!((lm[Landmark::LWrist.index()] - target).length() < 1e-9);
+        assert!(pose.euler(Joint::LElbow).z > 0.0);
+        // The elbow points backward of the shoulder–wrist line.
+        let mid = 0.5 * (sh + target);
+        assert!((lm[Landmark::LElbow.index()] - mid).x < 0.0);
     }
 }

@@ -1,6 +1,7 @@
 //! Motion generators and the figure they animate: one skeleton and one [`motion::Motion`] type
 //! shared by the running (RUNNER), walking (KLAW) and generalization (Ko–Badler) generators.
 pub mod anthropometry;
+pub mod checks;
 pub mod ik;
 pub mod motion;
 pub mod skeleton;

@@ -789,6 +789,26 @@ impl Skeleton {
         Pose::identity_at(DVec3::new(0.0, self.hip_height(), 0.0))
     }
 
+    /// World orientation and position of one joint, walking its chain from the root (cheaper
+    /// than a full [`Skeleton::forward`] when only one joint is needed).
+    pub fn joint_world(&self, pose: &Pose, joint: Joint) -> (DQuat, DVec3) {
+        let mut chain = [0usize; 8];
+        let mut n = 0;
+        let mut j = joint.index();
+        while j != 0 {
+            chain[n] = j;
+            n += 1;
+            j = PARENT[j];
+        }
+        let mut rot = pose.rotations[0];
+        let mut pos = pose.root;
+        for &k in chain[..n].iter().rev() {
+            pos += rot * self.offsets[k];
+            rot *= pose.rotations[k];
+        }
+        (rot, pos)
+    }
+
     /// Forward kinematics into `out` (no allocation).
     #[inline]
     pub fn forward_into(&self, pose: &Pose, out: &mut GlobalPose) {
@@ -817,7 +837,12 @@ impl Skeleton {
     pub fn landmarks_into(&self, global: &GlobalPose, out: &mut Landmarks) {
         for (o, &(j, off)) in out.iter_mut().zip(self.landmark_attach.iter()) {
             let j = j.index();
-            *o = global.positions[j] + global.rotations[j] * off;
+            // Most landmarks are joint centres: skip their (zero) rotation.
+            *o = if off == DVec3::ZERO {
+                global.positions[j]
+            } else {
+                global.positions[j] + global.rotations[j] * off
+            };
         }
     }
 
