@@ -189,6 +189,17 @@ fn trc_round_trip() {
                 assert!((p - m.landmark(i, l)).length() < 1e-6);
             }
         }
+        // gaitfit's own TRC reader gets the same markers, in metres.
+        let (ms, header, _) = gaitfit::ingest::trc::read_markers(&path).unwrap();
+        assert_eq!(header.num_frames, m.len());
+        assert_eq!(ms.names.len(), Landmark::ALL.len());
+        assert!((ms.rate_hz - 120.0).abs() < 1e-9);
+        for l in Landmark::ALL {
+            let traj = ms.get(l.name()).unwrap();
+            for (i, p) in traj.iter().enumerate() {
+                assert!((DVec3::from_array(*p) - m.landmark(i, l)).length() < 1e-6);
+            }
+        }
     }
 }
 
