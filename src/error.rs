@@ -30,6 +30,9 @@ pub enum Error {
     /// Locating or writing files.
     #[error(transparent)]
     Io(#[from] crate::fsio::FsError),
+    /// Building a relation from coefficients or a fits file.
+    #[error(transparent)]
+    Relation(#[from] crate::relations::RelationError),
 }
 
 /// `Result` with gaitfit's [`Error`].

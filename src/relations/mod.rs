@@ -1,1 +1,571 @@
 //! The published relations, one type per relation (one file each), behind one trait.
+//!
+//! | id | type | paper, equation |
+//! |---|---|---|
+//! | `run-sl-v` | [`RunSlV`] | running 1996, eq. 2 (with `v_norm`, §2.2) |
+//! | `run-tflight-sf` | [`RunTflightSf`] (paper's free pieces) | running 1996, eqs. 4–5 |
+//! | `run-tflight-sf-continuous` | [`RunTflightSf`] (continuous at `k1`) | running 1996, eqs. 4–5 |
+//! | `walk-sl-sf` | [`WalkSlSf`] | walking 1989, eq. 1 |
+//! | `walk-tds-sf` | [`WalkTdsSf`] | walking 1989, §3 (t_ds formula) |
+//!
+//! # Using a relation (generators)
+//! Every type has `published()` (the papers' coefficients), typed evaluation methods in the
+//! papers' units (e.g. [`RunSlV::step_length`]), and `from_fit_file("fits/<id>.json")` to use
+//! coefficients refitted by `gaitfit fit`. [`load_fit`] does the same behind the trait.
+//!
+//! ```
+//! use gaitfit::relations::{RunSlV, RunTflightSf, WalkSlSf, WalkTdsSf};
+//! let run = RunSlV::published();
+//! let sl = run.step_length(200.0, 1.8, 0.0);        // 12 km/h = 200 m/min
+//! assert!((sl - 1.07).abs() < 0.005);                // running paper §3.1: 1.07 m
+//! assert!((200.0 / sl - 187.0).abs() < 0.5);         // … and 187 steps/min
+//! let tf = RunTflightSf::published().flight_time(187.0);
+//! assert!((tf - 0.188).abs() < 0.0005);
+//! let walk = WalkSlSf::published();
+//! let sf = walk.step_freq_for_speed(5000.0 / 60.0, 1.8); // 5 km/h
+//! assert!((sf - 107.6).abs() < 0.05);
+//! assert!((WalkTdsSf::published().double_support_pct(100.0) - 13.08).abs() < 1e-9);
+//! ```
+//!
+//! # Adding a relation
+//! Implement [`Relation`] in one new file: metadata, `observe` (which [`Quantity`]s of a row it
+//! needs, converted to the papers' units), `parameters`, and `raw_basis` — the model must be
+//! linear in its [`ParamKind::Linear`] parameters once the [`ParamKind::Breakpoint`] ones are
+//! fixed (true of all the papers' relations); `predict` then comes for free. Register it in
+//! [`registry`]. The generic fit routine (`gaitfit::fit::pipeline`) produces the statistics,
+//! tables and plots without further code.
+pub mod run_sl_v;
+pub mod run_tflight_sf;
+pub mod walk_sl_sf;
+pub mod walk_tds_sf;
+
+pub use run_sl_v::RunSlV;
+pub use run_tflight_sf::{Continuity, RunTflightSf};
+pub use walk_sl_sf::WalkSlSf;
+pub use walk_tds_sf::WalkTdsSf;
+
+use crate::events::Gait;
+use crate::ingest::trials::FieldValues;
+use crate::units::Quantity;
+use nalgebra::{DMatrix, DVector};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Maximum number of inputs of a relation (the length of [`Observation::x`]).
+pub const MAX_INPUTS: usize = 4;
+
+/// Errors of the relations layer (building a relation from coefficients or a fits file).
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum RelationError {
+    /// The fits file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// The fits file is not valid JSON of the expected shape.
+    #[error("{path}: not a gaitfit fits file: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The relation id is not known.
+    #[error("unknown relation `{id}`; known: {known}")]
+    UnknownRelation {
+        /// The id found.
+        id: String,
+        /// The ids gaitfit knows.
+        known: String,
+    },
+    /// A coefficient is missing or not finite.
+    #[error("{relation}: coefficient `{name}` {message}")]
+    Coefficient {
+        /// Relation id.
+        relation: String,
+        /// Coefficient name.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Where a relation comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Citation {
+    /// Short reference (authors, year, title).
+    pub paper: &'static str,
+    /// Equation or section.
+    pub equation: &'static str,
+}
+
+/// A model variable (input or response), in the papers' units.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Variable {
+    /// Symbol as in the paper (`v`, `sf`, `sl`, `t_flight`, …).
+    pub symbol: &'static str,
+    /// Unit as the paper writes it (`m/min`, `steps/min`, `m`, `s`, `%`).
+    pub unit: &'static str,
+    /// Plain-language name.
+    pub name: &'static str,
+}
+
+/// How a parameter enters the model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ParamKind {
+    /// The prediction is linear in it (given the breakpoints): fitted by linear least squares.
+    Linear,
+    /// A breakpoint or other nonlinear parameter: profiled (the linear ones refitted at each
+    /// trial value) and given a profile-likelihood confidence interval.
+    Breakpoint,
+}
+
+/// A global parameter of a relation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParameterSpec {
+    /// Name (interface: used in fits files and exports).
+    pub name: &'static str,
+    /// Unit in the papers' terms.
+    pub unit: &'static str,
+    /// The published value.
+    pub published: f64,
+    /// Linear or breakpoint.
+    pub kind: ParamKind,
+    /// What it is.
+    pub description: &'static str,
+}
+
+/// A per-subject additive offset on one linear parameter (the running paper's `level`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SubjectEffect {
+    /// Name stem; coefficients are called `<name>[<subject>]`.
+    pub name: &'static str,
+    /// The linear parameter it offsets.
+    pub on: &'static str,
+    /// The paper's range: |offset| ≤ `paper_bound` (outside it a subject is flagged).
+    pub paper_bound: f64,
+    /// Unit.
+    pub unit: &'static str,
+}
+
+/// The input domain the published relation was derived on (papers' units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Domain {
+    /// Input symbol.
+    pub input: &'static str,
+    /// Lower end.
+    pub lo: f64,
+    /// Upper end.
+    pub hi: f64,
+    /// Where the range comes from.
+    pub note: &'static str,
+}
+
+/// One row reduced to what a relation uses: inputs and response in the papers' units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Inputs, in the order of [`Relation::inputs`]; unused slots are 0.
+    pub x: [f64; MAX_INPUTS],
+    /// Response.
+    pub y: f64,
+}
+
+/// Why a row cannot be used by a relation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Rejection {
+    /// A needed quantity is missing (empty cell or no column).
+    Missing(Quantity),
+    /// A value is outside what the relation can use (e.g. a zero step frequency).
+    Invalid(String),
+}
+
+impl std::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Rejection::Missing(q) => write!(f, "missing {}", q.canonical_header()),
+            Rejection::Invalid(s) => f.write_str(s),
+        }
+    }
+}
+
+/// Raw linear parameters from the coefficients of the fitting basis: `raw = map · β + shift`
+/// (rows: the relation's linear parameters in order; columns: basis coefficients).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearMap {
+    /// `n_linear × n_basis`.
+    pub map: DMatrix<f64>,
+    /// `n_linear`.
+    pub shift: DVector<f64>,
+}
+
+/// What a relation can fit on given data: which parameters are free, with notes for those held
+/// at their current (published) value, and the search bracket of each free breakpoint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// Per parameter (in [`Relation::parameters`] order): `None` when free, or why it is held.
+    pub held: Vec<Option<String>>,
+    /// Per parameter: the search bracket of a free breakpoint (`None` for linear ones).
+    pub search: Vec<Option<(f64, f64)>>,
+}
+
+/// A published gait relation (see the module docs).
+///
+/// Coefficient vectors (`p`) hold the global parameters in [`Relation::parameters`] order;
+/// per-subject effects are passed separately as an additive offset.
+pub trait Relation: Send + Sync + std::fmt::Debug {
+    /// The relation id (`run-sl-v`, …): interface, used for file names.
+    fn id(&self) -> &'static str;
+    /// One-line title.
+    fn title(&self) -> &'static str;
+    /// The paper and equation.
+    fn citation(&self) -> Citation;
+    /// The formula in the papers' units, as text.
+    fn equation(&self) -> &'static str;
+    /// The response variable.
+    fn response(&self) -> Variable;
+    /// The input variables (the first is the one plots use as abscissa).
+    fn inputs(&self) -> &'static [Variable];
+    /// The gait whose rows this relation uses.
+    fn gait(&self) -> Gait;
+    /// The row quantities it needs.
+    fn needs(&self) -> &'static [Quantity];
+    /// Reduces a row (SI) to inputs and response in the papers' units.
+    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection>;
+    /// The global parameters.
+    fn parameters(&self) -> &'static [ParameterSpec];
+    /// The per-subject effect, if the relation has one.
+    fn subject_effect(&self) -> Option<SubjectEffect> {
+        None
+    }
+    /// True when the model has an intercept (r² is then centred; otherwise uncentred, as NIST
+    /// defines it for regressions through the origin).
+    fn has_intercept(&self) -> bool;
+    /// The input domain of the published relation.
+    fn domain(&self) -> Domain;
+    /// Current coefficient values (published, or loaded from a fit), in `parameters()` order.
+    fn values(&self) -> &[f64];
+    /// Per-subject effects of the loaded fit (empty for published coefficients).
+    fn subject_levels(&self) -> &BTreeMap<String, f64>;
+
+    /// The derivatives of the prediction with respect to each [`ParamKind::Linear`] parameter
+    /// (in order), at the breakpoints in `p`: the model is `Σ_j p_lin[j] · g[j]`.
+    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]);
+
+    /// Number of linear parameters.
+    fn n_linear(&self) -> usize {
+        self.parameters()
+            .iter()
+            .filter(|s| s.kind == ParamKind::Linear)
+            .count()
+    }
+
+    /// Prediction with coefficients `p` and a per-subject offset on the
+    /// [`SubjectEffect::on`] parameter.
+    fn predict_with(&self, p: &[f64], subject_offset: f64, x: &[f64]) -> f64 {
+        let mut g = [0.0; 16];
+        let nl = self.n_linear();
+        self.raw_basis(p, x, &mut g[..nl]);
+        let on = self.subject_effect().map(|e| e.on);
+        let mut y = 0.0;
+        let mut j = 0;
+        for (i, s) in self.parameters().iter().enumerate() {
+            if s.kind == ParamKind::Linear {
+                let mut c = p[i];
+                if Some(s.name) == on {
+                    c += subject_offset;
+                }
+                y += c * g[j];
+                j += 1;
+            }
+        }
+        y
+    }
+
+    /// Prediction with the current coefficients for an average subject (offset 0).
+    fn predict(&self, x: &[f64]) -> f64 {
+        self.predict_with(self.values(), 0.0, x)
+    }
+
+    /// Analytic gradient of the prediction with respect to all global parameters, when
+    /// available. The default gives the linear part exactly and leaves breakpoints to the
+    /// caller (`None`).
+    fn gradient(&self, _p: &[f64], _x: &[f64]) -> Option<Vec<f64>> {
+        None
+    }
+
+    /// What can be fitted on these observations (default: every linear parameter free, every
+    /// breakpoint held — relations with breakpoints override this).
+    fn plan(&self, _obs: &[Observation]) -> Plan {
+        Plan {
+            held: self
+                .parameters()
+                .iter()
+                .map(|s| match s.kind {
+                    ParamKind::Linear => None,
+                    ParamKind::Breakpoint => Some("not fitted by this relation".to_string()),
+                })
+                .collect(),
+            search: vec![None; self.parameters().len()],
+        }
+    }
+
+    /// Number of basis columns for the free linear parameters `free` (mask over all params).
+    fn basis_len(&self, free: &[bool]) -> usize {
+        self.parameters()
+            .iter()
+            .zip(free)
+            .filter(|(s, f)| s.kind == ParamKind::Linear && **f)
+            .count()
+    }
+
+    /// The fitting basis for the free linear parameters at the breakpoints in `p`: fills `phi`
+    /// (length [`Relation::basis_len`]) and returns the offset (the contribution of held
+    /// linear parameters). The default is the raw basis; a relation overrides this (with
+    /// [`Relation::basis_to_params`]) to fit in a better-conditioned or constrained basis.
+    fn basis(&self, p: &[f64], free: &[bool], x: &[f64], phi: &mut [f64]) -> f64 {
+        let mut g = [0.0; 16];
+        let nl = self.n_linear();
+        self.raw_basis(p, x, &mut g[..nl]);
+        let mut k = 0;
+        let mut offset = 0.0;
+        for (j, (i, _)) in self
+            .parameters()
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.kind == ParamKind::Linear)
+            .enumerate()
+        {
+            if free[i] {
+                phi[k] = g[j];
+                k += 1;
+            } else {
+                offset += p[i] * g[j];
+            }
+        }
+        offset
+    }
+
+    /// Maps basis coefficients to the linear parameters (see [`LinearMap`]); must match
+    /// [`Relation::basis`].
+    fn basis_to_params(&self, p: &[f64], free: &[bool]) -> LinearMap {
+        let specs = self.parameters();
+        let lin: Vec<usize> = (0..specs.len())
+            .filter(|&i| specs[i].kind == ParamKind::Linear)
+            .collect();
+        let nb = self.basis_len(free);
+        let mut map = DMatrix::zeros(lin.len(), nb);
+        let mut shift = DVector::zeros(lin.len());
+        let mut k = 0;
+        for (j, &i) in lin.iter().enumerate() {
+            if free[i] {
+                map[(j, k)] = 1.0;
+                k += 1;
+            } else {
+                shift[j] = p[i];
+            }
+        }
+        LinearMap { map, shift }
+    }
+
+    /// The basis column that the subject effect multiplies (its coefficient must equal the
+    /// [`SubjectEffect::on`] parameter). The default finds `on` among the free linear
+    /// parameters of the raw basis.
+    fn subject_column(&self, free: &[bool]) -> Option<usize> {
+        let on = self.subject_effect()?.on;
+        let mut k = 0;
+        for (i, s) in self.parameters().iter().enumerate() {
+            if s.kind == ParamKind::Linear && free[i] {
+                if s.name == on {
+                    return Some(k);
+                }
+                k += 1;
+            }
+        }
+        None
+    }
+
+    /// A copy of this relation with other coefficient values (and per-subject levels).
+    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation>;
+
+    /// For a breakpoint `i`: the value at which the feature it marks vanishes from the data
+    /// (e.g. `+∞` for a plateau onset), so the fit can test whether the data show the feature
+    /// at all. `None` when the breakpoint is structural (always present).
+    fn breakpoint_null(&self, _i: usize) -> Option<f64> {
+        None
+    }
+
+    /// Derived quantities worth reporting for a coefficient vector (name, value, unit), e.g.
+    /// the jump of the flight-time curve at `k1`.
+    fn derived(&self, _p: &[f64]) -> Vec<(String, f64, &'static str)> {
+        Vec::new()
+    }
+
+    /// The published coefficients, in `parameters()` order.
+    fn published_values(&self) -> Vec<f64> {
+        self.parameters().iter().map(|s| s.published).collect()
+    }
+
+    /// The index of parameter `name`.
+    fn index_of(&self, name: &str) -> Option<usize> {
+        self.parameters().iter().position(|s| s.name == name)
+    }
+}
+
+/// A named set of coefficient values for one relation (what a fits file carries).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CoefficientSet {
+    /// Relation id.
+    pub relation: String,
+    /// `(name, value)` in file order; per-subject effects are named `<stem>[<subject>]`.
+    pub values: Vec<(String, f64)>,
+}
+
+impl CoefficientSet {
+    /// The value of `name`.
+    pub fn get(&self, name: &str) -> Option<f64> {
+        self.values.iter().find(|(n, _)| n == name).map(|(_, v)| *v)
+    }
+
+    /// Reads the `relation` id and the `coefficients[].name/value` of a fits JSON file written
+    /// by `gaitfit fit` (other keys are ignored).
+    pub fn from_fit_file(path: &Path) -> Result<CoefficientSet, RelationError> {
+        let text = std::fs::read_to_string(path).map_err(|e| RelationError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+        Self::from_fit_json(path, &text)
+    }
+
+    /// As [`CoefficientSet::from_fit_file`], from JSON text (`path` is for messages).
+    pub fn from_fit_json(path: &Path, text: &str) -> Result<CoefficientSet, RelationError> {
+        #[derive(serde::Deserialize)]
+        struct C {
+            name: String,
+            value: f64,
+        }
+        #[derive(serde::Deserialize)]
+        struct F {
+            relation: String,
+            coefficients: Vec<C>,
+        }
+        let f: F = serde_json::from_str(text).map_err(|e| RelationError::Format {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Ok(CoefficientSet {
+            relation: f.relation,
+            values: f
+                .coefficients
+                .into_iter()
+                .map(|c| (c.name, c.value))
+                .collect(),
+        })
+    }
+
+    /// Splits into global values in `specs` order and per-subject levels named
+    /// `<stem>[<subject>]`. Missing or non-finite global coefficients are errors.
+    pub fn split(
+        &self,
+        specs: &[ParameterSpec],
+        effect: Option<SubjectEffect>,
+    ) -> Result<(Vec<f64>, BTreeMap<String, f64>), RelationError> {
+        let mut vals = Vec::with_capacity(specs.len());
+        for s in specs {
+            let v = self.get(s.name).ok_or_else(|| RelationError::Coefficient {
+                relation: self.relation.clone(),
+                name: s.name.to_string(),
+                message: "is missing".to_string(),
+            })?;
+            if !v.is_finite() {
+                return Err(RelationError::Coefficient {
+                    relation: self.relation.clone(),
+                    name: s.name.to_string(),
+                    message: format!("is not finite ({v})"),
+                });
+            }
+            vals.push(v);
+        }
+        let mut levels = BTreeMap::new();
+        if let Some(e) = effect {
+            let prefix = format!("{}[", e.name);
+            for (n, v) in &self.values {
+                if let Some(s) = n.strip_prefix(&prefix).and_then(|r| r.strip_suffix(']')) {
+                    levels.insert(s.to_string(), *v);
+                }
+            }
+        }
+        Ok((vals, levels))
+    }
+}
+
+/// Every relation gaitfit knows, with published coefficients, in report order.
+pub fn registry() -> Vec<Box<dyn Relation>> {
+    vec![
+        Box::new(RunSlV::published()),
+        Box::new(RunTflightSf::published()),
+        Box::new(RunTflightSf::published_continuous()),
+        Box::new(WalkSlSf::published()),
+        Box::new(WalkTdsSf::published()),
+    ]
+}
+
+/// The relation with id `id` (published coefficients).
+pub fn by_id(id: &str) -> Result<Box<dyn Relation>, RelationError> {
+    registry()
+        .into_iter()
+        .find(|r| r.id() == id)
+        .ok_or_else(|| RelationError::UnknownRelation {
+            id: id.to_string(),
+            known: registry()
+                .iter()
+                .map(|r| r.id())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
+}
+
+/// The relation of a fits file, with the refitted coefficients.
+pub fn from_coefficients(set: &CoefficientSet) -> Result<Box<dyn Relation>, RelationError> {
+    let r = by_id(&set.relation)?;
+    let (vals, levels) = set.split(r.parameters(), r.subject_effect())?;
+    Ok(r.with_values(&vals, levels))
+}
+
+/// Loads `fits/<id>.json` as a relation with the refitted coefficients.
+pub fn load_fit(path: &Path) -> Result<Box<dyn Relation>, RelationError> {
+    from_coefficients(&CoefficientSet::from_fit_file(path)?)
+}
+
+/// Checks that `set` is for relation `id` (used by the typed `from_fit_file` constructors).
+pub(crate) fn expect_id(set: &CoefficientSet, id: &str, path: &Path) -> Result<(), RelationError> {
+    if set.relation == id {
+        Ok(())
+    } else {
+        Err(RelationError::Format {
+            path: path.to_path_buf(),
+            message: format!("is a fit of `{}`, not of `{id}`", set.relation),
+        })
+    }
+}
+
+/// The analytic gradient of the linear part (helper for relations whose breakpoints have no
+/// useful derivative): `∂y/∂p_i = g_j` for linear `i`, 0 for breakpoints.
+pub fn linear_gradient(r: &dyn Relation, p: &[f64], x: &[f64]) -> Vec<f64> {
+    let mut g = [0.0; 16];
+    let nl = r.n_linear();
+    r.raw_basis(p, x, &mut g[..nl]);
+    let mut out = vec![0.0; p.len()];
+    let mut j = 0;
+    for (i, s) in r.parameters().iter().enumerate() {
+        if s.kind == ParamKind::Linear {
+            out[i] = g[j];
+            j += 1;
+        }
+    }
+    out
+}

@@ -1,0 +1,302 @@
+//! `run-sl-v`: step length from speed in running, Bruderlin & Calvert (1996) §2.2, eq. 2.
+//!
+//! ```text
+//! sl = a + (b + level) · v · √(h/1.8)            for v ≤ v_norm · √(h/1.8)
+//! sl = a + (b + level) · v_norm · (h/1.8)        above (sl_norm: only sf increases)
+//! ```
+//! sl in m, v in m/min, body height h in m; published a = 0.1394 m, b = 0.00465 m per m/min,
+//! v_norm = 400 m/min (for h = 1.8 m), −0.001 ≤ level ≤ 0.001 (poor … skilled runner). The
+//! paper derived a and b by linear regression on n = 80 pairs with v ≤ 400 m/min (r² = 0.94442).
+//!
+//! Decision (the paper is not explicit): the plateau starts where the Froude-scaled speed
+//! reaches v_norm, i.e. at v = v_norm·√(h/1.8), and the step length stays at its value there, so
+//! the curve is continuous. Tested in `tests/reference_run_sl_v.rs`.
+//!
+//! ```
+//! use gaitfit::relations::RunSlV;
+//! let r = RunSlV::published();
+//! // Running paper §3.1 (Figure 4): at 12 km/h the chosen step length is 1.07 m, 187 steps/min.
+//! assert!((r.step_length(200.0, 1.8, 0.0) - 1.0694).abs() < 1e-9);
+//! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
+//! ```
+use super::{
+    expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
+    ParameterSpec, Plan, Rejection, Relation, RelationError, SubjectEffect, Variable,
+};
+use crate::events::Gait;
+use crate::ingest::trials::FieldValues;
+use crate::units::{m_per_s_to_m_per_min, Quantity};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The reference body height of the running paper's normalisation, m.
+pub const REFERENCE_HEIGHT_M: f64 = 1.8;
+
+const PARAMS: &[ParameterSpec] = &[
+    ParameterSpec {
+        name: "a",
+        unit: "m",
+        published: 0.1394,
+        kind: ParamKind::Linear,
+        description: "intercept",
+    },
+    ParameterSpec {
+        name: "b",
+        unit: "m per m/min",
+        published: 0.00465,
+        kind: ParamKind::Linear,
+        description: "slope on the height-normalised speed v·√(h/1.8)",
+    },
+    ParameterSpec {
+        name: "v_norm",
+        unit: "m/min",
+        published: 400.0,
+        kind: ParamKind::Breakpoint,
+        description: "speed (at h = 1.8 m) above which step length stays constant",
+    },
+];
+
+const INPUTS: &[Variable] = &[
+    Variable {
+        symbol: "v",
+        unit: "m/min",
+        name: "speed",
+    },
+    Variable {
+        symbol: "h",
+        unit: "m",
+        name: "body height",
+    },
+];
+
+/// The running step length–speed relation (eq. 2) with its plateau above `v_norm`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSlV {
+    values: Vec<f64>,
+    levels: BTreeMap<String, f64>,
+}
+
+impl RunSlV {
+    /// The id.
+    pub const ID: &'static str = "run-sl-v";
+
+    /// The published coefficients (a = 0.1394, b = 0.00465, v_norm = 400).
+    pub fn published() -> Self {
+        RunSlV {
+            values: PARAMS.iter().map(|p| p.published).collect(),
+            levels: BTreeMap::new(),
+        }
+    }
+    /// Explicit coefficients.
+    pub fn new(a: f64, b: f64, v_norm: f64) -> Self {
+        RunSlV {
+            values: vec![a, b, v_norm],
+            levels: BTreeMap::new(),
+        }
+    }
+    /// From a coefficient set (e.g. a fits file's).
+    pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
+        let (values, levels) = set.split(PARAMS, Some(LEVEL))?;
+        Ok(RunSlV { values, levels })
+    }
+    /// From `fits/run-sl-v.json` written by `gaitfit fit`.
+    pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
+        let set = CoefficientSet::from_fit_file(path)?;
+        expect_id(&set, Self::ID, path)?;
+        Self::from_coefficients(&set)
+    }
+    /// Intercept a, m.
+    pub fn a(&self) -> f64 {
+        self.values[0]
+    }
+    /// Slope b, m per m/min.
+    pub fn b(&self) -> f64 {
+        self.values[1]
+    }
+    /// Plateau onset v_norm at h = 1.8 m, m/min.
+    pub fn v_norm(&self) -> f64 {
+        self.values[2]
+    }
+    /// The fitted level of `subject` (0 when unknown).
+    pub fn level(&self, subject: &str) -> f64 {
+        self.levels.get(subject).copied().unwrap_or(0.0)
+    }
+
+    /// Step length (m) at speed `v` (m/min) for body height `h` (m) and expertise `level`.
+    pub fn step_length(&self, v: f64, h: f64, level: f64) -> f64 {
+        sl(&self.values, level, v, h)
+    }
+    /// Step frequency (steps/min) = v / sl (eq. 1).
+    pub fn step_freq(&self, v: f64, h: f64, level: f64) -> f64 {
+        v / self.step_length(v, h, level)
+    }
+    /// The plateau step length sl_norm (m) for body height `h`.
+    pub fn sl_norm(&self, h: f64, level: f64) -> f64 {
+        let r2 = h / REFERENCE_HEIGHT_M;
+        self.a() + (self.b() + level) * self.v_norm() * r2
+    }
+    /// The speed (m/min) at which the relation gives step frequency `sf` (steps/min), solving
+    /// v = sl(v)·sf; `None` when no speed gives that frequency (sf too high for the linear part
+    /// and below the plateau's).
+    pub fn speed_for_step_freq(&self, sf: f64, h: f64, level: f64) -> Option<f64> {
+        let r = (h / REFERENCE_HEIGHT_M).sqrt();
+        let (a, b) = (self.a(), self.b() + level);
+        let den = 1.0 - b * r * sf;
+        if den > 0.0 {
+            let v = a * sf / den;
+            if v <= self.v_norm() * r && v >= 0.0 {
+                return Some(v);
+            }
+        }
+        let v = self.sl_norm(h, level) * sf;
+        (v >= self.v_norm() * r).then_some(v)
+    }
+    /// The speed (m/min) at which the relation gives step length `sl` (m) below the plateau.
+    pub fn speed_for_step_length(&self, sl: f64, h: f64, level: f64) -> Option<f64> {
+        let r = (h / REFERENCE_HEIGHT_M).sqrt();
+        let v = (sl - self.a()) / ((self.b() + level) * r);
+        (v >= 0.0 && v <= self.v_norm() * r).then_some(v)
+    }
+}
+
+const LEVEL: SubjectEffect = SubjectEffect {
+    name: "level",
+    on: "b",
+    paper_bound: 0.001,
+    unit: "m per m/min",
+};
+
+/// The regressor z = min(v, v_norm·r)·r with r = √(h/1.8).
+fn z(v_norm: f64, v: f64, h: f64) -> f64 {
+    let r = (h / REFERENCE_HEIGHT_M).sqrt();
+    v.min(v_norm * r) * r
+}
+
+fn sl(p: &[f64], level: f64, v: f64, h: f64) -> f64 {
+    p[0] + (p[1] + level) * z(p[2], v, h)
+}
+
+impl Relation for RunSlV {
+    fn id(&self) -> &'static str {
+        Self::ID
+    }
+    fn title(&self) -> &'static str {
+        "Running: step length from speed (Froude-normalised, with plateau)"
+    }
+    fn citation(&self) -> Citation {
+        Citation {
+            paper: "Bruderlin & Calvert (1996), Knowledge-driven, interactive animation of human running",
+            equation: "eq. 2 and v_norm (§2.2)",
+        }
+    }
+    fn equation(&self) -> &'static str {
+        "sl = a + (b + level)·min(v, v_norm·√(h/1.8))·√(h/1.8)"
+    }
+    fn response(&self) -> Variable {
+        Variable {
+            symbol: "sl",
+            unit: "m",
+            name: "step length",
+        }
+    }
+    fn inputs(&self) -> &'static [Variable] {
+        INPUTS
+    }
+    fn gait(&self) -> Gait {
+        Gait::Run
+    }
+    fn needs(&self) -> &'static [Quantity] {
+        &[Quantity::Speed, Quantity::StepLength, Quantity::BodyHeight]
+    }
+    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
+        let v = row
+            .get(Quantity::Speed)
+            .ok_or(Rejection::Missing(Quantity::Speed))?;
+        let sl = row
+            .get(Quantity::StepLength)
+            .ok_or(Rejection::Missing(Quantity::StepLength))?;
+        let h = row
+            .get(Quantity::BodyHeight)
+            .ok_or(Rejection::Missing(Quantity::BodyHeight))?;
+        if h <= 0.0 {
+            return Err(Rejection::Invalid(format!(
+                "body height {h} m is not positive"
+            )));
+        }
+        Ok(Observation {
+            x: [m_per_s_to_m_per_min(v), h, 0.0, 0.0],
+            y: sl,
+        })
+    }
+    fn parameters(&self) -> &'static [ParameterSpec] {
+        PARAMS
+    }
+    fn subject_effect(&self) -> Option<SubjectEffect> {
+        Some(LEVEL)
+    }
+    fn has_intercept(&self) -> bool {
+        true
+    }
+    fn domain(&self) -> Domain {
+        Domain {
+            input: "v",
+            lo: 0.0,
+            hi: 400.0,
+            note: "regression data had v ≤ 400 m/min (n = 80, r² = 0.94442); constant above v_norm",
+        }
+    }
+    fn values(&self) -> &[f64] {
+        &self.values
+    }
+    fn subject_levels(&self) -> &BTreeMap<String, f64> {
+        &self.levels
+    }
+    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]) {
+        g[0] = 1.0;
+        g[1] = z(p[2], x[0], x[1]);
+    }
+    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+        let mut d = linear_gradient(self, p, x);
+        let r = (x[1] / REFERENCE_HEIGHT_M).sqrt();
+        // On the plateau sl = a + b·v_norm·r², so ∂sl/∂v_norm = b·r²; 0 below.
+        d[2] = if x[0] > p[2] * r { p[1] * r * r } else { 0.0 };
+        Some(d)
+    }
+    fn plan(&self, obs: &[Observation]) -> Plan {
+        let mut u: Vec<f64> = obs
+            .iter()
+            .map(|o| o.x[0] / (o.x[1] / REFERENCE_HEIGHT_M).sqrt())
+            .collect();
+        u.sort_by(f64::total_cmp);
+        u.dedup();
+        // At least 3 distinct normalised speeds on each side of any trial breakpoint.
+        let (held, search) = if u.len() >= 8 {
+            (None, Some((u[2], u[u.len() - 3])))
+        } else {
+            (
+                Some(format!(
+                    "needs at least 8 distinct speeds to locate the plateau (have {})",
+                    u.len()
+                )),
+                None,
+            )
+        };
+        Plan {
+            held: vec![None, None, held],
+            search: vec![None, None, search],
+        }
+    }
+    fn breakpoint_null(&self, _i: usize) -> Option<f64> {
+        Some(f64::INFINITY)
+    }
+    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
+        Box::new(RunSlV {
+            values: values.to_vec(),
+            levels,
+        })
+    }
+    fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {
+        let r = RunSlV::new(p[0], p[1], p[2]);
+        vec![("sl_norm(h=1.8)".to_string(), r.sl_norm(1.8, 0.0), "m")]
+    }
+}
