@@ -47,5 +47,10 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group! {
+    name = benches;
+    // No plots: the plotters backend needs system fonts the CI machine does not have.
+    config = Criterion::default().without_plots();
+    targets = bench
+}
 criterion_main!(benches);

@@ -192,3 +192,60 @@ fn pose_index_and_euler_accessors_agree() {
     assert!((p.euler(Joint::LKnee).z + 0.5).abs() < 1e-12);
     assert_eq!(p[Joint::LKnee], DQuat::from_rotation_z(-0.5));
 }
+
+#[test]
+fn pelvis_list_sign_lowers_the_right_hip() {
+    let sk = Skeleton::from_height(1.8, 80.0).unwrap();
+    let mut pose = sk.rest_pose();
+    pose.set_euler(Joint::Pelvis, Euler::new(0.0, 0.1, 0.0));
+    let lm = sk.landmarks(&pose);
+    assert!(lm[Landmark::RHip.index()].y < lm[Landmark::LHip.index()].y);
+    // Ankle +x on the right foot: inversion (lateral, +z, edge down).
+    let mut pose = sk.rest_pose();
+    pose.set_euler(Joint::RAnkle, Euler::new(0.0, 0.2, 0.0));
+    let g = sk.forward(&pose);
+    assert!((g.rotation(Joint::RAnkle) * DVec3::Z).y < 0.0);
+}
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn angles() -> impl Strategy<Value = Vec<(f64, f64, f64)>> {
+        proptest::collection::vec((-3.0f64..3.0, -1.5f64..1.5, -3.0f64..3.0), 22)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Any pose keeps every segment length and every landmark's distance to its joint; the
+        /// Euler decomposition reproduces every rotation.
+        #[test]
+        fn fk_is_rigid_and_euler_round_trips(a in angles(), root in (-5.0f64..5.0, 0.0f64..2.0, -5.0f64..5.0)) {
+            let sk = Skeleton::from_height(1.75, 70.0).unwrap();
+            let mut pose = sk.rest_pose();
+            pose.root = DVec3::new(root.0, root.1, root.2);
+            for (j, (z, x, y)) in Joint::ALL.iter().zip(a.iter()) {
+                pose.set_euler(*j, Euler::new(*z, *x, *y));
+                let back = pose.euler(*j).to_quat();
+                prop_assert!(back.dot(pose[*j]).abs() > 1.0 - 1e-12);
+            }
+            let g = sk.forward(&pose);
+            for j in Joint::ALL.iter().skip(1) {
+                let p = j.parent().unwrap();
+                let d = (g.position(*j) - g.position(p)).length();
+                prop_assert!((d - sk.offset(*j).length()).abs() < 1e-12);
+            }
+            let lm = sk.landmarks(&pose);
+            for l in Landmark::ALL {
+                let (j, off) = sk.landmark_attachment(l);
+                prop_assert!(((lm[l.index()] - g.position(j)).length() - off.length()).abs() < 1e-12);
+            }
+            let rest = sk.landmarks(&sk.rest_pose());
+            // Heel–toe distance is rigid only with the toe joint at rest; check heel–ankle.
+            let ha = (lm[Landmark::LHeel.index()] - lm[Landmark::LAnkle.index()]).length();
+            let ha0 = (rest[Landmark::LHeel.index()] - rest[Landmark::LAnkle.index()]).length();
+            prop_assert!((ha - ha0).abs() < 1e-12);
+        }
+    }
+}
