@@ -1,7 +1,7 @@
 //! The crate-level error: one variant per layer, each wrapping that layer's own `thiserror` enum.
 //!
 //! Library functions return their layer's error; code that crosses layers (the pipelines behind
-//! the CLI) returns [`Error`]. Every message names its subject (file, row, column, frame or
+//! the CLI) returns [`Error`](enum@Error). Every message names its subject (file, row, column, frame or
 //! channel) and, where there is one, the remedy.
 use thiserror::Error;
 
@@ -35,5 +35,5 @@ pub enum Error {
     Relation(#[from] crate::relations::RelationError),
 }
 
-/// `Result` with gaitfit's [`Error`].
+/// `Result` with gaitfit's [`Error`](enum@Error).
 pub type Result<T, E = Error> = std::result::Result<T, E>;
