@@ -204,3 +204,30 @@ fn unknown_format_and_missing_file() {
     let e = read_trial(&d.path().join("nope.trc"), &ReadOptions::default()).unwrap_err();
     assert!(matches!(e, IngestError::Io { .. }));
 }
+
+#[test]
+fn treadmill_grf_errors() {
+    let d = tempfile::tempdir().unwrap();
+    let head = "Time\tFx1\tFy1\tFz1\tCOPx1\tCOPy1\tCOPz1\tTy1\n";
+    let p = write(
+        d.path(),
+        "a_grf.txt",
+        &format!("{head}1\t1\t600\t2\t2000\t0\t1100\t10\n2\t1\t610\t2\t2001\t0\t1100\n"),
+    );
+    let e = err(&p);
+    assert!(e.contains("row 3") && e.contains("Ty1"), "{e}");
+    let p = write(
+        d.path(),
+        "b_grf.txt",
+        &format!("{head}1\t1\t600\t2\t2000\t0\t1100\t10\n1\t1\t610\t2\t2001\t0\t1100\t10\n"),
+    );
+    let e = err(&p);
+    assert!(e.contains("row 3") && e.contains("Time"), "{e}");
+    let p = write(
+        d.path(),
+        "c_grf.txt",
+        "Time\tFx1\tFy1\tFz1\tCOPx1\n1\t1\t2\t3\t4\n",
+    );
+    let e = err(&p);
+    assert!(e.contains("COPy1"), "{e}");
+}

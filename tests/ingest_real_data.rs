@@ -191,3 +191,48 @@ fn hamner_running_grf_and_subjects() {
     assert_eq!(s.markers.as_ref().unwrap().names.len(), 64);
     assert_eq!(s.markers.as_ref().unwrap().len(), 397);
 }
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn wbds_treadmill_subject04() {
+    // WBDSinfo.csv: subject 04, 184 cm, 61.05 kg, leg ≈ 0.94 m; speeds 1.30–1.88 m/s.
+    for (trial, speed) in [("T05", 1.30), ("T06", 1.49), ("T07", 1.69), ("T08", 1.88)] {
+        let rel = format!("wbds/WBDS04walk{trial}grf.txt");
+        let t = read(&rel);
+        assert_eq!(
+            t.setting,
+            Setting::Treadmill {
+                belt_speed_m_per_s: speed
+            },
+            "{rel}"
+        );
+        assert_eq!(t.gait, Some(gaitfit::events::Gait::Walk));
+        assert_eq!(t.subject.id.as_deref(), Some("WBDS04"));
+        assert_eq!(t.subject.body_height_m, Some(1.84));
+        assert_eq!(t.subject.mass_kg, Some(61.05));
+        let leg = t.subject.leg_length_m.unwrap();
+        assert!((leg - 0.94).abs() < 0.01, "{rel}: leg {leg}");
+        assert_eq!(t.plates.len(), 2);
+        for p in &t.plates {
+            assert_eq!(p.rate_hz, 300.0);
+            assert_eq!(p.time_s.len(), 9000, "30 s at 300 Hz");
+            assert!((p.time_s[8999] - 29.99667).abs() < 1e-4);
+        }
+        y_up_x_forward(&t);
+        // Belt 2 lies on the subject's right (+Z when walking toward +X with Y up).
+        assert_eq!(t.plates[0].side, Some(Side::Left), "{:?}", t.notes);
+        assert_eq!(t.plates[1].side, Some(Side::Right));
+        // Body weight check: mean total vertical force ≈ 61.05 kg × g. Measured: 563 N at T05,
+        // i.e. 57.4 kg (−6 %); the export zeroes forces below its own threshold (the unloaded
+        // belt reads exactly 0), which loses part of the loading ramps.
+        let n = t.plates[0].force_n.len();
+        let mean: f64 = (0..n)
+            .map(|i| t.plates[0].force_n[i][1] + t.plates[1].force_n[i][1])
+            .sum::<f64>()
+            / n as f64;
+        assert!(
+            (mean / (61.05 * 9.81) - 1.0).abs() < 0.08,
+            "{rel}: mean Fy {mean}"
+        );
+    }
+}

@@ -14,6 +14,7 @@ pub mod hamner;
 pub mod mot;
 pub(crate) mod text;
 pub mod trc;
+pub mod treadmill;
 pub mod trials;
 pub mod types;
 pub mod winter;
@@ -130,6 +131,9 @@ pub struct ReadOptions {
     /// Centre of pressure is reported only while the vertical force exceeds this, N (default
     /// 20 N); below it the plate is unloaded and the COP is `NaN`.
     pub cop_min_force_n: f64,
+    /// Sampling rate of force files that do not state one (WBDS GRF text, whose `Time` column
+    /// holds sample numbers); `None` → the data set's documented rate (300 Hz for WBDS).
+    pub grf_rate_hz: Option<f64>,
 }
 
 impl Default for ReadOptions {
@@ -142,6 +146,7 @@ impl Default for ReadOptions {
             gait: None,
             belt_speed_m_per_s: None,
             cop_min_force_n: 20.0,
+            grf_rate_hz: None,
         }
     }
 }
@@ -233,7 +238,8 @@ pub fn read_trial(path: &Path, opts: &ReadOptions) -> Result<Trial, IngestError>
         Format::Mot => mot::read(path, opts),
         Format::Forces => forces::read(path, opts),
         Format::Winter => winter::read(path, opts),
-        f @ (Format::TreadmillGrf | Format::C3d | Format::FrameCsv) => Err(IngestError::malformed(
+        Format::TreadmillGrf => treadmill::read(path, opts),
+        f @ (Format::C3d | Format::FrameCsv) => Err(IngestError::malformed(
             path,
             format!("{f:?} files are not readable yet in this version of gaitfit"),
         )),
