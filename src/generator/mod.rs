@@ -5,6 +5,7 @@ pub mod checks;
 pub mod ik;
 pub mod motion;
 pub mod skeleton;
+pub mod walking;
 
 use thiserror::Error;
 
