@@ -19,7 +19,7 @@ fn stance_equations_match_the_lagrangian_at_random_states() {
     for _ in 0..200 {
         let h = rng.random_range(1.5..2.0);
         let m = rng.random_range(50.0..100.0);
-        let model = StanceModel::new(&Body::from_table_b1(h, m));
+        let model = StanceModel::new(&Body::from_height(h, m).unwrap());
         let q = [
             rng.random_range(0.6..1.1),
             rng.random_range(-0.8..0.8),
@@ -74,13 +74,21 @@ fn swing_equations_match_the_lagrangian_at_random_states() {
     for _ in 0..200 {
         let h = rng.random_range(1.5..2.0);
         let m = rng.random_range(50.0..100.0);
-        let model = SwingModel::new(&Body::from_table_b1(h, m));
+        let model = SwingModel::new(&Body::from_height(h, m).unwrap());
         let q = [rng.random_range(-1.0..1.0), rng.random_range(0.0..1.5)];
         let qd = [rng.random_range(-6.0..6.0), rng.random_range(-10.0..10.0)];
         let hip_vel = [rng.random_range(-2.0..2.0), rng.random_range(-1.0..1.0)];
         let hip_acc = [rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0)];
-        let f = [rng.random_range(-100.0..100.0), rng.random_range(-50.0..50.0)];
-        let z = [q[0], q[1], rng.random_range(-1.0..1.0), rng.random_range(0.7..1.1)];
+        let f = [
+            rng.random_range(-100.0..100.0),
+            rng.random_range(-50.0..50.0),
+        ];
+        let z = [
+            q[0],
+            q[1],
+            rng.random_range(-1.0..1.0),
+            rng.random_range(0.7..1.1),
+        ];
         let zd = [qd[0], qd[1], hip_vel[0], hip_vel[1]];
         let t = lagrange::terms(&SwingMechanism(model), &z, &zd);
         let printed_m = model.mass_matrix(&q);
@@ -108,7 +116,7 @@ fn swing_equations_match_the_lagrangian_at_random_states() {
 fn the_printed_theta4_typo_would_fail_the_cross_check() {
     // A.2 as printed has m4 l3 r4 θ̇4 (2θ̇3 + θ4) sin θ4: the Lagrangian disagrees with it, so the
     // cross-check does detect the typo.
-    let model = SwingModel::new(&Body::from_table_b1(1.8, 80.0));
+    let model = SwingModel::new(&Body::from_height(1.8, 80.0).unwrap());
     let (q, qd) = ([-0.3, 0.8], [2.0, -5.0]);
     let z = [q[0], q[1], 0.0, 0.9];
     let zd = [qd[0], qd[1], 0.0, 0.0];
@@ -124,7 +132,7 @@ fn the_printed_theta4_typo_would_fail_the_cross_check() {
 /// Total energy over one step of a free (unforced, undamped) motion.
 #[test]
 fn energy_is_conserved_with_forces_and_damping_off() {
-    let body = Body::from_table_b1(1.8, 80.0);
+    let body = Body::from_height(1.8, 80.0).unwrap();
     let h = 1e-3;
     let duration = 0.56; // one step at 5 km/h (sf = 107.5 steps/min)
 
@@ -141,11 +149,16 @@ fn energy_is_conserved_with_forces_and_damping_off() {
     let y0 = [0.9, -0.4, 0.05, -0.3, 1.6, 0.2];
     let e0 = energy(&y0);
     let mut worst: f64 = 0.0;
-    let end = integrate::<6, _, NoEvent<6>, _>(&mut f, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
-        worst = worst.max((energy(y) - e0).abs());
-    });
+    let end =
+        integrate::<6, _, NoEvent<6>, _>(&mut f, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
+            worst = worst.max((energy(y) - e0).abs());
+        });
     assert!(end.t == duration);
-    assert!(worst / e0.abs() < 1e-6, "stance: relative drift {}", worst / e0.abs());
+    assert!(
+        worst / e0.abs() < 1e-6,
+        "stance: relative drift {}",
+        worst / e0.abs()
+    );
 
     // Stance with the conservative leg spring (damping off): spring energy joins the total.
     let (kw, l1) = (20_000.0, body.l1);
@@ -160,7 +173,11 @@ fn energy_is_conserved_with_forces_and_damping_off() {
     integrate::<6, _, NoEvent<6>, _>(&mut fs, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
         worst = worst.max((energy_s(y) - e0).abs());
     });
-    assert!(worst / e0.abs() < 1e-6, "stance with spring: relative drift {}", worst / e0.abs());
+    assert!(
+        worst / e0.abs() < 1e-6,
+        "stance with spring: relative drift {}",
+        worst / e0.abs()
+    );
 
     // Swing with the hip at rest: an unforced double pendulum.
     let sw = SwingModel::new(&body);
@@ -177,5 +194,9 @@ fn energy_is_conserved_with_forces_and_damping_off() {
     integrate::<4, _, NoEvent<4>, _>(&mut fw, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
         worst = worst.max((energy_w(y) - e0).abs());
     });
-    assert!(worst / e0.abs() < 1e-6, "swing: relative drift {}", worst / e0.abs());
+    assert!(
+        worst / e0.abs() < 1e-6,
+        "swing: relative drift {}",
+        worst / e0.abs()
+    );
 }

@@ -12,56 +12,13 @@
 //! dimensionally kg·m⁴. The table's definition gives `I_3 = 8 · 0.138² = 0.1515 kg·m²`, which is
 //! also what Winter's tables (the source of γ = 0.323 for the thigh) give. We use the table.
 //!
-//! The foot segments (`l_8`, `l_9`, `l_11`, `l_12`, `l_13`) carry no mass: the model's feet are
-//! kinematic (§4).
-
-/// Relative segment values of table B-1 (lengths / body height, masses / body mass).
-pub mod table_b1 {
-    /// Pelvis width `l_0` (hip joint to hip joint).
-    pub const L0: f64 = 0.10059;
-    /// Leg: centre of mass from the distal end (ankle), fraction of `l_1`.
-    pub const R1: f64 = 0.553;
-    /// Leg: radius of gyration, fraction of `l_1`.
-    pub const GAMMA1: f64 = 0.326;
-    /// Upper body length.
-    pub const L2: f64 = 0.47;
-    /// Upper body mass.
-    pub const M2: f64 = 0.678;
-    /// Upper body centre of mass from the hip, fraction of `l_2`.
-    pub const R2: f64 = 0.5;
-    /// Upper body radius of gyration, fraction of `l_2`.
-    pub const GAMMA2: f64 = 0.496;
-    /// Thigh length.
-    pub const L3: f64 = 0.23669;
-    /// Thigh mass.
-    pub const M3: f64 = 0.1;
-    /// Thigh centre of mass from the hip, fraction of `l_3`.
-    pub const R3: f64 = 0.433;
-    /// Thigh radius of gyration, fraction of `l_3`.
-    pub const GAMMA3: f64 = 0.323;
-    /// Shank length.
-    pub const L4: f64 = 0.24556;
-    /// Shank mass.
-    pub const M4: f64 = 0.061;
-    /// Shank centre of mass from the knee, fraction of `l_4`.
-    pub const R4: f64 = 0.606;
-    /// Shank radius of gyration, fraction of `l_4`.
-    pub const GAMMA4: f64 = 0.416;
-    /// Mid foot length `l_5`.
-    pub const L5: f64 = 0.0858;
-    /// Toe length `l_6`.
-    pub const L6: f64 = 0.04734;
-    /// Hind foot `l_8` (horizontal heel–ankle distance).
-    pub const L8: f64 = 0.02959;
-    /// Ankle to foot base `l_9` (ankle height over a flat foot).
-    pub const L9: f64 = 0.03846;
-    /// Heel to ankle `l_11`.
-    pub const L11: f64 = 0.04853;
-    /// Ankle to first metatarsal head `l_12`.
-    pub const L12: f64 = 0.08901;
-    /// First metatarsal head to toe tip `l_13`.
-    pub const L13: f64 = 0.0496;
-}
+//! The foot carries no mass: the model's feet are kinematic (§4); its geometry is the shared
+//! figure's ([`FootGeometry`](crate::generator::anthropometry::FootGeometry)).
+//!
+//! The values come from the shared figure ([`Anthropometry`]), so the dynamics and the exported
+//! skeleton have the same proportions.
+use crate::generator::anthropometry::Anthropometry;
+use crate::generator::GenerateError;
 
 /// Absolute segment values (SI) of the KLAW dynamic model for one body.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,64 +67,61 @@ pub struct Body {
     pub l9: f64,
     /// Heel to ankle `l_11`, m.
     pub l11: f64,
-    /// Ankle to first metatarsal head `l_12`, m.
-    pub l12: f64,
-    /// First metatarsal head to toe tip `l_13`, m.
-    pub l13: f64,
+    /// Heel sole point relative to the ankle, foot flat, m (x forward, y up).
+    pub heel: [f64; 2],
+    /// Metatarsal (ball) joint centre relative to the ankle, foot flat, m.
+    pub mtp: [f64; 2],
+    /// Ball sole point (under the metatarsal joint) relative to the ankle, foot flat, m.
+    pub ball: [f64; 2],
+    /// Toe tip relative to the ankle, foot flat, m.
+    pub toe: [f64; 2],
 }
 
 impl Body {
-    /// Absolute values from body height (m) and mass (kg) by table B-1; `I = m·(γ·l)²`.
-    ///
-    /// The caller validates height and mass (see [`super::high_level`]).
-    pub fn from_table_b1(height_m: f64, mass_kg: f64) -> Body {
-        use table_b1 as t;
-        let h = height_m;
-        let m = mass_kg;
-        let l3 = t::L3 * h;
-        let l4 = t::L4 * h;
-        let l1 = l3 + l4;
-        let m3 = t::M3 * m;
-        let m4 = t::M4 * m;
-        let m1 = m3 + m4;
-        let l2 = t::L2 * h;
-        let m2 = t::M2 * m;
+    /// The dynamic model of the shared figure's anthropometry (table B-1; `I = m·(γ·l)²`).
+    pub fn new(a: &Anthropometry) -> Body {
+        let leg = a.leg();
+        let f = &a.foot;
+        let mtp = [f.mid_foot_m, f.metatarsal_height_m - f.ankle_height_m];
         Body {
-            height_m,
-            mass_kg,
-            l0: t::L0 * h,
-            l1,
-            m1,
-            r1: t::R1 * l1,
-            i1: m1 * (t::GAMMA1 * l1).powi(2),
-            l2,
-            m2,
-            r2: t::R2 * l2,
-            i2: m2 * (t::GAMMA2 * l2).powi(2),
-            l3,
-            m3,
-            r3: t::R3 * l3,
-            i3: m3 * (t::GAMMA3 * l3).powi(2),
-            l4,
-            m4,
-            r4: t::R4 * l4,
-            i4: m4 * (t::GAMMA4 * l4).powi(2),
-            l8: t::L8 * h,
-            l9: t::L9 * h,
-            l11: t::L11 * h,
-            l12: t::L12 * h,
-            l13: t::L13 * h,
+            height_m: a.height_m,
+            mass_kg: a.mass_kg,
+            l0: a.hip_width_m,
+            l1: leg.length_m,
+            m1: leg.mass_kg,
+            r1: leg.com_from_distal_m(),
+            i1: leg.moment_of_inertia_kg_m2(),
+            l2: a.upper_body.length_m,
+            m2: a.upper_body.mass_kg,
+            r2: a.upper_body.com_from_proximal_m,
+            i2: a.upper_body.moment_of_inertia_kg_m2(),
+            l3: a.thigh.length_m,
+            m3: a.thigh.mass_kg,
+            r3: a.thigh.com_from_proximal_m,
+            i3: a.thigh.moment_of_inertia_kg_m2(),
+            l4: a.shank.length_m,
+            m4: a.shank.mass_kg,
+            r4: a.shank.com_from_proximal_m,
+            i4: a.shank.moment_of_inertia_kg_m2(),
+            l8: f.hind_foot_m,
+            l9: f.ankle_height_m,
+            l11: f.heel_ankle_m(),
+            heel: [-f.hind_foot_m, -f.ankle_height_m],
+            mtp,
+            ball: [f.mid_foot_m, -f.ankle_height_m],
+            toe: [f.mid_foot_m + f.toe_m, -f.ankle_height_m],
         }
+    }
+
+    /// The dynamic model of a figure of height `height_m` and mass `mass_kg` with the table's
+    /// proportions.
+    pub fn from_height(height_m: f64, mass_kg: f64) -> Result<Body, GenerateError> {
+        Ok(Body::new(&Anthropometry::from_height(height_m, mass_kg)?))
     }
 
     /// Angle `ω_8` between the sole and the heel–ankle line, `cos ω_8 = l_8 / l_11` (§3).
     pub fn omega8(&self) -> f64 {
         (self.l8 / self.l11).clamp(-1.0, 1.0).acos()
-    }
-
-    /// Horizontal distance from the ankle to the first metatarsal head over a flat foot, m.
-    pub fn ankle_to_meta_x(&self) -> f64 {
-        (self.l12 * self.l12 - self.l9 * self.l9).max(0.0).sqrt()
     }
 }
 
@@ -178,27 +132,29 @@ mod tests {
     #[test]
     fn thigh_example_of_appendix_b() {
         // Appendix B, h = 1.8 m, m = 80 kg: m3 = 8 kg, l3 = 0.426 m, r3 = 0.184 m, γ3 = 0.138 m.
-        let b = Body::from_table_b1(1.8, 80.0);
+        let b = Body::from_height(1.8, 80.0).unwrap();
         assert!((b.m3 - 8.0).abs() < 1e-12);
         assert!((b.l3 - 0.426).abs() < 5e-4);
         assert!((b.r3 - 0.184).abs() < 5e-4);
-        assert!((table_b1::GAMMA3 * b.l3 - 0.138).abs() < 5e-4);
         // The table's I = m·(γ·l)² ...
         assert!((b.i3 - 0.1515).abs() < 5e-4, "I3 = {}", b.i3);
-        // ... while the printed 0.0276 is m·(l·γ_abs)², a length too many.
-        // (With the printed, rounded 0.426 m and 0.138 m: 8·(0.426·0.138)² = 0.02766.)
+        // ... while the printed 0.0276 is m·(l·γ_abs)² with the printed, rounded 0.426 m and
+        // 0.138 m (a length too many).
         let misprint = 8.0 * (0.426f64 * 0.138).powi(2);
-        assert!((misprint - 0.0276).abs() < 1e-4, "misprint reproduces as {misprint}");
-        let dimensionally_consistent = 8.0 * 0.138f64.powi(2);
-        assert!((dimensionally_consistent - b.i3).abs() < 1e-3);
+        assert!(
+            (misprint - 0.0276).abs() < 1e-4,
+            "misprint reproduces as {misprint}"
+        );
+        assert!((8.0 * 0.138f64.powi(2) - b.i3).abs() < 1e-3);
     }
 
     #[test]
-    fn masses_add_up_and_heel_geometry_is_consistent() {
-        let b = Body::from_table_b1(1.8, 80.0);
+    fn masses_add_up_and_leg_is_the_table_leg() {
+        let b = Body::from_height(1.8, 80.0).unwrap();
         // Upper body + two legs = whole body (the feet are massless).
         assert!((b.m2 + 2.0 * b.m1 - 80.0).abs() < 1e-9);
-        // l11 is the hypotenuse of l8 and l9 (to the table's 4 digits).
-        assert!(((b.l8.powi(2) + b.l9.powi(2)).sqrt() - b.l11).abs() < 1e-4 * 1.8);
+        assert!((b.l1 - b.l3 - b.l4).abs() < 1e-12);
+        assert!((b.r1 - 0.553 * b.l1).abs() < 1e-12);
+        assert!((b.i1 - b.m1 * (0.326 * b.l1).powi(2)).abs() < 1e-12);
     }
 }

@@ -112,7 +112,11 @@ impl StanceModel {
         let a23 = self.m2 * self.r2 * w * c21;
         [
             [self.m2, 0.0, a13],
-            [0.0, self.i1 + self.m1 * self.r1 * self.r1 + self.m2 * w * w, a23],
+            [
+                0.0,
+                self.i1 + self.m1 * self.r1 * self.r1 + self.m2 * w * w,
+                a23,
+            ],
             [a13, a23, self.i2 + self.m2 * self.r2 * self.r2],
         ]
     }
@@ -250,7 +254,11 @@ impl SwingModel {
         let k = self.m4 * self.l3 * self.r4;
         let a22 = self.i4 + self.m4 * self.r4 * self.r4;
         let a12 = a22 + k * c4;
-        let a11 = self.i3 + self.m3 * self.r3 * self.r3 + self.m4 * self.l3 * self.l3 + a22 + 2.0 * k * c4;
+        let a11 = self.i3
+            + self.m3 * self.r3 * self.r3
+            + self.m4 * self.l3 * self.l3
+            + a22
+            + 2.0 * k * c4;
         [[a11, a12], [a12, a22]]
     }
 
@@ -301,7 +309,9 @@ impl SwingModel {
     /// Gravitational potential energy relative to the hip, J.
     pub fn potential_energy(&self, q: &[f64; 2]) -> f64 {
         let [t3, t4] = *q;
-        -self.g * (self.m3 * self.r3 * t3.cos() + self.m4 * (self.l3 * t3.cos() + self.r4 * (t3 + t4).cos()))
+        -self.g
+            * (self.m3 * self.r3 * t3.cos()
+                + self.m4 * (self.l3 * t3.cos() + self.r4 * (t3 + t4).cos()))
     }
 
     /// Knee and ankle positions relative to the hip, m.

@@ -99,14 +99,22 @@ where
 {
     let n = step_count(t1 - t0, h_max);
     if n == 0 {
-        return SegmentEnd { t: t0, y: y0, event: false };
+        return SegmentEnd {
+            t: t0,
+            y: y0,
+            event: false,
+        };
     }
     let h = (t1 - t0) / n as f64;
     let mut y = y0;
     let mut g_prev = event.as_mut().map(|e| e(t0, &y0));
     for k in 0..n {
         let t = t0 + k as f64 * h;
-        let t_next = if k + 1 == n { t1 } else { t0 + (k + 1) as f64 * h };
+        let t_next = if k + 1 == n {
+            t1
+        } else {
+            t0 + (k + 1) as f64 * h
+        };
         let y_next = rk4_step(f, t, &y, t_next - t);
         if let (Some(e), Some(gp)) = (event.as_mut(), g_prev) {
             let g = e(t_next, &y_next);
@@ -144,14 +152,22 @@ where
                 let tau = if b - a < 1e-12 { b } else { tau };
                 let yt = rk4_step(f, t, &y, tau);
                 observe(t, &y, t + tau, &yt);
-                return SegmentEnd { t: t + tau, y: yt, event: true };
+                return SegmentEnd {
+                    t: t + tau,
+                    y: yt,
+                    event: true,
+                };
             }
             g_prev = Some(g);
         }
         observe(t, &y, t_next, &y_next);
         y = y_next;
     }
-    SegmentEnd { t: t1, y, event: false }
+    SegmentEnd {
+        t: t1,
+        y,
+        event: false,
+    }
 }
 
 /// Spectral radius of the Jacobian of `f` at `(t, y)` (central differences, QR eigenvalues).
@@ -172,7 +188,10 @@ where
             jac[(i, j)] = (fp[i] - fm[i]) / (2.0 * d);
         }
     }
-    jac.complex_eigenvalues().iter().map(|c| c.norm()).fold(0.0, f64::max)
+    jac.complex_eigenvalues()
+        .iter()
+        .map(|c| c.norm())
+        .fold(0.0, f64::max)
 }
 
 /// The largest RK4 step that is stable for a system whose Jacobian has spectral radius `rho`,
@@ -210,7 +229,13 @@ mod tests {
         let err = |h: f64| {
             let mut f = |_t: f64, y: &[f64; 1]| [-y[0]];
             let end = integrate::<1, _, fn(f64, &[f64; 1]) -> f64, _>(
-                &mut f, 0.0, [1.0], 1.0, h, None, &mut |_, _, _, _| {},
+                &mut f,
+                0.0,
+                [1.0],
+                1.0,
+                h,
+                None,
+                &mut |_, _, _, _| {},
             );
             assert_eq!(end.t, 1.0);
             (end.y[0] - (-1.0f64).exp()).abs()
@@ -225,7 +250,15 @@ mod tests {
         let g = 9.81;
         let mut f = |_t: f64, y: &[f64; 2]| [y[1], -g];
         let mut ev = |_t: f64, y: &[f64; 2]| -y[0];
-        let end = integrate(&mut f, 0.0, [1.0, 0.0], 2.0, 0.01, Some(&mut ev), &mut |_, _, _, _| {});
+        let end = integrate(
+            &mut f,
+            0.0,
+            [1.0, 0.0],
+            2.0,
+            0.01,
+            Some(&mut ev),
+            &mut |_, _, _, _| {},
+        );
         assert!(end.event);
         assert!((end.t - (2.0 / g).sqrt()).abs() < 1e-10, "t = {}", end.t);
         assert!(end.y[0].abs() < 1e-10);
@@ -240,7 +273,13 @@ mod tests {
         assert!((rho - c).abs() / c < 0.01, "ρ = {rho}");
         let h = stable_step(rho, 0.01);
         let end = integrate::<2, _, fn(f64, &[f64; 2]) -> f64, _>(
-            &mut f, 0.0, [1.0, 0.0], 1.0, h, None, &mut |_, _, _, _| {},
+            &mut f,
+            0.0,
+            [1.0, 0.0],
+            1.0,
+            h,
+            None,
+            &mut |_, _, _, _| {},
         );
         assert!(end.y[0].abs() < 1.0 && end.y[1].abs() < 10.0, "{:?}", end.y);
     }

@@ -56,36 +56,57 @@ pub struct Dual<S> {
 impl<S: Scalar> Add for Dual<S> {
     type Output = Self;
     fn add(self, o: Self) -> Self {
-        Dual { re: self.re + o.re, du: self.du + o.du }
+        Dual {
+            re: self.re + o.re,
+            du: self.du + o.du,
+        }
     }
 }
 impl<S: Scalar> Sub for Dual<S> {
     type Output = Self;
     fn sub(self, o: Self) -> Self {
-        Dual { re: self.re - o.re, du: self.du - o.du }
+        Dual {
+            re: self.re - o.re,
+            du: self.du - o.du,
+        }
     }
 }
 impl<S: Scalar> Mul for Dual<S> {
     type Output = Self;
     fn mul(self, o: Self) -> Self {
-        Dual { re: self.re * o.re, du: self.re * o.du + self.du * o.re }
+        Dual {
+            re: self.re * o.re,
+            du: self.re * o.du + self.du * o.re,
+        }
     }
 }
 impl<S: Scalar> Neg for Dual<S> {
     type Output = Self;
     fn neg(self) -> Self {
-        Dual { re: -self.re, du: -self.du }
+        Dual {
+            re: -self.re,
+            du: -self.du,
+        }
     }
 }
 impl<S: Scalar> Scalar for Dual<S> {
     fn cst(x: f64) -> Self {
-        Dual { re: S::cst(x), du: S::cst(0.0) }
+        Dual {
+            re: S::cst(x),
+            du: S::cst(0.0),
+        }
     }
     fn sin(self) -> Self {
-        Dual { re: self.re.sin(), du: self.re.cos() * self.du }
+        Dual {
+            re: self.re.sin(),
+            du: self.re.cos() * self.du,
+        }
     }
     fn cos(self) -> Self {
-        Dual { re: self.re.cos(), du: -(self.re.sin() * self.du) }
+        Dual {
+            re: self.re.cos(),
+            du: -(self.re.sin() * self.du),
+        }
     }
 }
 
@@ -134,7 +155,10 @@ fn potential<S: Scalar, M: Mechanism>(m: &M, z: &[S]) -> S {
 type D2 = Dual<Dual<f64>>;
 
 fn d2(x: f64, outer: f64, inner: f64) -> D2 {
-    Dual { re: Dual { re: x, du: inner }, du: Dual { re: outer, du: 0.0 } }
+    Dual {
+        re: Dual { re: x, du: inner },
+        du: Dual { re: outer, du: 0.0 },
+    }
 }
 
 /// The Lagrangian equations of motion at one state.
@@ -169,10 +193,16 @@ pub fn terms<M: Mechanism>(m: &M, z: &[f64], zd: &[f64]) -> LagrangeTerms {
     for (i, b) in bias.iter_mut().enumerate() {
         // (∂²T/∂ż_i∂z)·ż: outer ε on ż_i, inner ε along z + ε ż.
         let zz: Vec<D2> = (0..n).map(|k| d2(z[k], 0.0, zd[k])).collect();
-        let vv: Vec<D2> = (0..n).map(|k| d2(zd[k], if k == i { 1.0 } else { 0.0 }, 0.0)).collect();
+        let vv: Vec<D2> = (0..n)
+            .map(|k| d2(zd[k], if k == i { 1.0 } else { 0.0 }, 0.0))
+            .collect();
         let mixed = kinetic(m, &zz, &vv).du.du;
-        let zq: Vec<Dual<f64>> =
-            (0..n).map(|k| Dual { re: z[k], du: if k == i { 1.0 } else { 0.0 } }).collect();
+        let zq: Vec<Dual<f64>> = (0..n)
+            .map(|k| Dual {
+                re: z[k],
+                du: if k == i { 1.0 } else { 0.0 },
+            })
+            .collect();
         let vq: Vec<Dual<f64>> = zd.iter().map(|&x| Dual { re: x, du: 0.0 }).collect();
         let dt_dz = kinetic(m, &zq, &vq).du;
         let dv_dz = potential(m, &zq).du;
@@ -225,7 +255,12 @@ impl Mechanism for StanceMechanism {
         let hip = [w * s1, w * c1];
         vec![
             // The leg pivots at the ankle; its centre of mass stays r1 from it (table B-1).
-            RigidBody { mass: p.m1, inertia: p.i1, com: [S::cst(p.r1) * s1, S::cst(p.r1) * c1], angle: t1 },
+            RigidBody {
+                mass: p.m1,
+                inertia: p.i1,
+                com: [S::cst(p.r1) * s1, S::cst(p.r1) * c1],
+                angle: t1,
+            },
             RigidBody {
                 mass: p.m2,
                 inertia: p.i2,

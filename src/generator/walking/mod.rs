@@ -1,5 +1,7 @@
 //! KLAW: goal-directed, dynamic walking (Bruderlin & Calvert 1989).
+pub mod attributes;
 pub mod body;
 pub mod dynamics;
+pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
