@@ -1,5 +1,6 @@
 //! The printed equations of motion (appendix A, corrected) against an independent Lagrangian
 //! derivation, and energy conservation of the integrator with forces and damping off.
+#![allow(clippy::needless_range_loop)] // matrices are compared entry by entry
 use gaitfit::generator::walking::body::Body;
 use gaitfit::generator::walking::dynamics::{StanceModel, SwingModel};
 use gaitfit::generator::walking::integrate::integrate;

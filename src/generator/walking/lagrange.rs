@@ -176,8 +176,8 @@ pub struct LagrangeTerms {
 pub fn terms<M: Mechanism>(m: &M, z: &[f64], zd: &[f64]) -> LagrangeTerms {
     let n = m.dof();
     let mut mass = vec![vec![0.0; n]; n];
-    for i in 0..n {
-        for j in 0..n {
+    for (i, row) in mass.iter_mut().enumerate() {
+        for (j, mij) in row.iter_mut().enumerate() {
             let zz: Vec<D2> = z.iter().map(|&x| d2(x, 0.0, 0.0)).collect();
             let vv: Vec<D2> = (0..n)
                 .map(|k| {
@@ -186,7 +186,7 @@ pub fn terms<M: Mechanism>(m: &M, z: &[f64], zd: &[f64]) -> LagrangeTerms {
                     d2(zd[k], o, inn)
                 })
                 .collect();
-            mass[i][j] = kinetic(m, &zz, &vv).du.du;
+            *mij = kinetic(m, &zz, &vv).du.du;
         }
     }
     let mut bias = vec![0.0; n];
