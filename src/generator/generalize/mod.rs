@@ -6,8 +6,8 @@
 //! - [`walk_data`]: W(S, sl) = {H, F₁, F₂, F₃, M, A} on normalized step time (eqs. 1–4), the
 //!   moments FGM, MOM, TOM and the anthropometry B(S) of Table 2;
 //! - [`mu`]: the μ-functions (appendix A, eqs. 21–24);
-//! - [`phi`]: step-length generalization φ_ρ (appendix B, eqs. 25–40);
-//! - [`psi`]: anthropometry generalization ψ (appendix C, eqs. 41–48);
+//! - [`mod@phi`]: step-length generalization φ_ρ (appendix B, eqs. 25–40);
+//! - [`mod@psi`]: anthropometry generalization ψ (appendix C, eqs. 41–48);
 //! - [`geometry`]: foot pivots, leg inverse kinematics, the hip heights of eq. 27;
 //! - [`Generalizer`]: prototype + μ-functions → the combined generalization τ (eqs. 11–12)
 //!   and chains of steps.
