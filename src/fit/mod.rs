@@ -1,6 +1,22 @@
 //! Least-squares fitting: linear (QR/SVD in a scaled basis, via nalgebra) and nonlinear (argmin),
 //! with the statistics a publication needs.
+//!
+//! - [`ols`]: weighted/unweighted linear least squares ([`ols::ols`]), polynomial fits in a
+//!   centred/scaled basis reported in the raw basis ([`ols::polynomial_fit`]), Huber IRLS
+//!   ([`ols::huber_irls`]);
+//! - [`nonlinear`]: nonlinear least squares through argmin's trust-region solver
+//!   ([`nonlinear::nls`]) for any [`nonlinear::Model`], and a bounded 1-D minimiser
+//!   ([`nonlinear::minimize_1d`]) for profiling breakpoints;
+//! - [`stats`]: quantiles, LRE, r², AIC/BIC, leave-one-group-out and the seeded group bootstrap;
+//! - [`prec`]: every named tolerance of the fitting layer in one place;
+//! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
 use thiserror::Error;
+
+pub mod nonlinear;
+pub mod ols;
+pub mod prec;
+pub mod stats;
+pub mod strd;
 
 /// Errors of the fitting layer.
 #[derive(Debug, Error)]
@@ -32,6 +48,36 @@ pub enum FitError {
         /// Relation id or data set name.
         relation: String,
         /// Details.
+        message: String,
+    },
+    /// An input value is NaN or infinite.
+    #[error("{relation}: {what} at row {row} is not finite ({value}); remove or repair that row")]
+    NonFinite {
+        /// Relation id or data set name.
+        relation: String,
+        /// Which input ("y", "x column 2", "weight", …).
+        what: String,
+        /// 0-based row index.
+        row: usize,
+        /// The offending value.
+        value: f64,
+    },
+    /// Inputs are inconsistent (mismatched lengths, bad weights, bad options).
+    #[error("{relation}: invalid input: {message}")]
+    InvalidInput {
+        /// Relation id or data set name.
+        relation: String,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// A NIST StRD reference file could not be read or parsed.
+    #[error("{file}: line {line}: {message}")]
+    Strd {
+        /// The file.
+        file: String,
+        /// 1-based line number (0 when the problem is not tied to one line).
+        line: usize,
+        /// What is wrong.
         message: String,
     },
 }
