@@ -231,3 +231,25 @@ fn treadmill_grf_errors() {
     let e = err(&p);
     assert!(e.contains("COPy1"), "{e}");
 }
+
+#[test]
+fn c3d_bad_header_and_truncation() {
+    let d = tempfile::tempdir().unwrap();
+    let mut b = vec![0u8; 1536];
+    b[0] = 2;
+    b[1] = 0x42;
+    let p = write_bytes(d.path(), "key.c3d", &b);
+    assert!(err(&p).contains("not the C3D key 0x50"));
+    b[1] = 0x50;
+    b[512 + 3] = 7;
+    let p = write_bytes(d.path(), "proc.c3d", &b);
+    assert!(err(&p).contains("processor type 7"));
+    let p = write_bytes(d.path(), "short.c3d", &b[..300]);
+    assert!(err(&p).contains("512-byte header"));
+}
+
+fn write_bytes(dir: &Path, name: &str, body: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, body).unwrap();
+    p
+}

@@ -236,3 +236,170 @@ fn wbds_treadmill_subject04() {
         );
     }
 }
+
+/// Loaded interval (vertical force above 20 N) of a plate: (first, last) sample times.
+fn loaded_interval(p: &gaitfit::ingest::types::ForcePlate, up: usize) -> Option<(f64, f64)> {
+    let first = p.force_n.iter().position(|f| f[up] > 20.0)?;
+    let last = p.force_n.iter().rposition(|f| f[up] > 20.0)?;
+    Some((p.time_s[first], p.time_s[last]))
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn c3d_gait_sample() {
+    let t = read("bmclab/Gait.c3d");
+    let m = t.markers.as_ref().unwrap();
+    assert_eq!((m.rate_hz, m.names.len(), m.len()), (100.0, 33, 487));
+    assert!(
+        t.notes
+            .iter()
+            .any(|n| n.contains("Dec processor, integer data")),
+        "{:?}",
+        t.notes
+    );
+    // Frame 200 RASI, as read independently by the Python `c3d` package (0.5):
+    // (1198.927, 90.479, 906.506) mm.
+    let rasi = m.get("RASI").unwrap()[199];
+    for (a, b) in rasi.iter().zip([1.198927, 0.090479, 0.906506]) {
+        assert!((a - b).abs() < 2e-6, "{rasi:?}");
+    }
+    let f = t.frame.as_ref().unwrap();
+    assert_eq!(
+        (f.vertical, f.forward, f.forward_sign),
+        (Axis::Z, Axis::X, -1.0),
+        "{}",
+        f.how
+    );
+    assert_eq!(t.plates.len(), 2);
+    for p in &t.plates {
+        assert_eq!((p.rate_hz, p.time_s.len()), (1000.0, 4870));
+        let peak = p.force_n.iter().map(|f| f[2]).fold(0.0, f64::max);
+        assert!((700.0..1000.0).contains(&peak), "{}: peak {peak}", p.name);
+        let (a, b) = loaded_interval(p, 2).unwrap();
+        assert!((0.45..0.75).contains(&(b - a)), "walking stance {}", b - a);
+    }
+    assert!(t.reference_events.is_empty());
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn c3d_schreiber_dynamic_trials() {
+    // SUBJECT:VALUES per participant (age, gender, weight kg, height m, R/L leg length m), as
+    // read independently by the Python `c3d` package.
+    let subjects = [
+        ("2014001", 67.0, 1.655, 0.731, 0.735),
+        ("2014004", 72.5, 1.77, 0.829, 0.848),
+        ("2014007", 65.0, 1.69, 0.837, 0.838),
+        ("2014014", 92.0, 1.80, 0.842, 0.847),
+        ("2014015", 67.0, 1.58, 0.716, 0.708),
+        ("2014019", 73.8, 1.755, 0.819, 0.828),
+    ];
+    let root = require("schreiber2019");
+    let mut files = 0;
+    for (id, mass, height, rleg, lleg) in subjects {
+        let dir = root.join(id).join("dynamic");
+        let mut names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "c3d"))
+            .collect();
+        names.sort();
+        assert_eq!(names.len(), 2, "{id}: C4 and C5");
+        for p in names {
+            files += 1;
+            let t = read_trial(&p, &ReadOptions::default()).unwrap();
+            let m = t.markers.as_ref().unwrap();
+            assert_eq!((m.rate_hz, m.names.len()), (100.0, 52));
+            assert_eq!(t.subject.mass_kg, Some(mass));
+            assert!((t.subject.body_height_m.unwrap() - height).abs() < 1e-3);
+            assert!((t.subject.leg_length_m.unwrap() - (rleg + lleg) / 2.0).abs() < 1e-3);
+            assert_eq!(t.gait, Some(gaitfit::events::Gait::Walk));
+            assert_eq!(t.setting, Setting::Overground);
+            let f = t.frame.as_ref().unwrap();
+            assert_eq!(f.vertical, Axis::Z, "{}", f.how);
+            assert_eq!(t.reference_events.len(), 7, "{}", p.display());
+            assert!(t
+                .reference_events
+                .iter()
+                .all(|e| e.source == gaitfit::events::EventSource::Reference));
+            assert_eq!(t.plates.len(), 2);
+            // Every plate loaded by one whole stance starts and ends within 40 ms (4 marker
+            // frames) of a reference foot strike / foot off (measured: ≤ 27 ms; the reference
+            // events are at marker-frame resolution and were not set from the 20 N threshold).
+            for pl in &t.plates {
+                assert_eq!(pl.rate_hz, 1500.0);
+                let Some((a, b)) = loaded_interval(pl, 2) else {
+                    continue;
+                };
+                if a < 0.01 || b > pl.time_s[pl.time_s.len() - 1] - 0.01 {
+                    continue;
+                }
+                let near = |k: gaitfit::events::EventKind, at: f64| t_min(&t_events(&t, k), at);
+                let hs = near(gaitfit::events::EventKind::HeelStrike, a);
+                let to = near(gaitfit::events::EventKind::ToeOff, b);
+                println!(
+                    "{} {}: onset-strike {hs:.3} s, end-off {to:.3} s",
+                    p.display(),
+                    pl.name
+                );
+                assert!(
+                    hs < 0.04,
+                    "{} {}: onset {a} is {hs} s from a strike",
+                    p.display(),
+                    pl.name
+                );
+                assert!(
+                    to < 0.04,
+                    "{} {}: end {b} is {to} s from a foot off",
+                    p.display(),
+                    pl.name
+                );
+            }
+        }
+    }
+    assert_eq!(files, 12);
+    // 2014001_C4_05 frame 51, first marker (L_IAS) = (491.302, 125.429, 851.317) mm (Python
+    // `c3d`).
+    let t = read("schreiber2019/2014001/dynamic/2014001_C4_05.c3d");
+    let p = t.markers.as_ref().unwrap().positions[0][50];
+    for (a, b) in p.iter().zip([0.491302, 0.125429, 0.851317]) {
+        assert!((a - b).abs() < 2e-6, "{p:?}");
+    }
+    // The static trials and the inverse-kinematics tables read too.
+    for id in [
+        "2014001", "2014004", "2014007", "2014014", "2014015", "2014019",
+    ] {
+        let t = read(&format!("schreiber2019/{id}/static/{id}_ST.c3d"));
+        let m = t.markers.as_ref().unwrap();
+        assert_eq!(
+            (m.names.len(), m.len()),
+            (52, 1),
+            "static trials hold one averaged frame"
+        );
+        for e in std::fs::read_dir(root.join(id).join("ik")).unwrap() {
+            for f in std::fs::read_dir(e.unwrap().path()).unwrap() {
+                let f = f.unwrap().path();
+                let table = mot::read_table(&f).unwrap_or_else(|e| panic!("{e}"));
+                assert!(
+                    table.time_s.len() > 20 && table.in_degrees == Some(true),
+                    "{}",
+                    f.display()
+                );
+            }
+        }
+    }
+}
+
+fn t_events(t: &Trial, k: gaitfit::events::EventKind) -> Vec<f64> {
+    t.reference_events
+        .iter()
+        .filter(|e| e.kind == k)
+        .map(|e| e.time_s)
+        .collect()
+}
+
+fn t_min(v: &[f64], t: f64) -> f64 {
+    v.iter()
+        .map(|x| (x - t).abs())
+        .fold(f64::INFINITY, f64::min)
+}

@@ -39,7 +39,7 @@ pub fn is_pelvis_marker(name: &str) -> bool {
     contains_any(
         name,
         &[
-            "ASI", "PSI", "HJC", "HIP", "GTR", "TROCH", "PELV", "SACR", "ILIAC",
+            "ASI", "PSI", "IAS", "IPS", "HJC", "HIP", "GTR", "FTC", "TROCH", "PELV", "SAC", "ILIAC",
         ],
     )
 }
@@ -49,16 +49,18 @@ pub fn is_foot_marker(name: &str) -> bool {
     contains_any(
         name,
         &[
-            "HEE", "CAL", "TOE", "MT", "MET", "BALL", "ANK", "MAL", "AJC",
+            "HEE", "CAL", "FCC", "TOE", "MT", "FM1", "FM2", "FM5", "MET", "BALL", "ANK", "MAL",
+            "AJC", "FAL", "TAM",
         ],
     )
 }
 
 fn is_heel(name: &str) -> bool {
-    contains_any(name, &["HEE", "CAL"])
+    contains_any(name, &["HEE", "CAL", "FCC"])
 }
 fn is_toe(name: &str) -> bool {
-    contains_any(name, &["TOE", "MT1", "MT2", "MET", "BALL"]) && !contains_any(name, &["STATIC"])
+    contains_any(name, &["TOE", "MT1", "MT2", "FM1", "FM2", "MET", "BALL"])
+        && !contains_any(name, &["STATIC"])
 }
 
 /// Side of a marker from its name prefix (`R.`, `R_`, `RHEE`, `RIGHT …`, `L…`).

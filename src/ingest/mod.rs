@@ -7,6 +7,7 @@
 //! set, fills short marker gaps ([`gaps`]) and establishes the laboratory frame
 //! ([`frame_detect`]). Every reader converts to SI once, from the units its file declares, and
 //! records what it assumed in [`Trial::notes`].
+pub mod c3d;
 pub mod forces;
 pub mod frame_detect;
 pub mod gaps;
@@ -239,7 +240,8 @@ pub fn read_trial(path: &Path, opts: &ReadOptions) -> Result<Trial, IngestError>
         Format::Forces => forces::read(path, opts),
         Format::Winter => winter::read(path, opts),
         Format::TreadmillGrf => treadmill::read(path, opts),
-        f @ (Format::C3d | Format::FrameCsv) => Err(IngestError::malformed(
+        Format::C3d => c3d::read(path, opts),
+        f @ Format::FrameCsv => Err(IngestError::malformed(
             path,
             format!("{f:?} files are not readable yet in this version of gaitfit"),
         )),
