@@ -1,13 +1,39 @@
 //! Gait event detection (heel strike, foot flat, heel off, meta off, toe off) from force plates
 //! and from kinematics, and the per-step spatiotemporal tables built from the events.
+//!
+//! - [`filter`]: zero-phase Butterworth low-pass (forward–backward, scipy's edge handling);
+//! - [`force`]: vertical GRF threshold with hysteresis per foot, baseline offset and drift;
+//! - [`kinematic`]: Zeni et al. (2008) coordinate method and its velocity variant;
+//! - [`phases`]: foot flat (FGM), heel off, meta off (MOM), toe off (TOM) from foot markers;
+//! - [`steps`]: one row per step in the trials schema, plus flight height (running paper eq. 3),
+//!   double support (walking paper §3) and the Ko–Badler μ inputs;
+//! - [`compare`]: detection F1 and timing error of one event source against another;
+//! - [`plot`]: a per-trial SVG of the vertical GRF and foot-marker traces with the events;
+//! - [`markers`]: which marker plays which role, with presets for common marker sets.
+//!
+//! The entry points are [`detect`] (all events of a trial) and [`steps_from_trial`] (events,
+//! then the per-step table).
+pub mod compare;
+pub mod filter;
+pub mod force;
+pub mod kinematic;
+pub mod markers;
+pub mod phases;
+pub mod plot;
+pub mod steps;
+pub mod synthetic;
 pub mod types;
 
+pub use markers::MarkerMap;
+pub use steps::{steps_from_analysis, Analysis, StepExtra, StepTable};
 pub use types::{EventKind, EventSource, Gait, GaitEvent, Side};
 
+use crate::ingest::types::{Setting, Trial};
+use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 /// Errors of the event layer. Every message names the file and, where relevant, the frame and
-/// channel.
+/// channel, and says what would fix it.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum EventError {
@@ -35,4 +61,308 @@ pub enum EventError {
         /// What is missing.
         what: String,
     },
+    /// A marker needed for detection has a gap that the reader could not fill.
+    #[error(
+        "{path}: frame {frame} (t = {time_s:.3} s), marker {marker} ({role}): missing for \
+         {frames} frame(s); fill the gap, trim the trial, or map the role to another marker \
+         with --marker {role}=NAME"
+    )]
+    MarkerGap {
+        /// The trial's source file.
+        path: String,
+        /// The marker (or the alternative `A+B` in use).
+        marker: String,
+        /// The role it plays (`r_heel`, `pelvis`, …).
+        role: String,
+        /// First missing frame (1-based, as in the file).
+        frame: usize,
+        /// Time of that frame, s.
+        time_s: f64,
+        /// Length of the gap, frames.
+        frames: usize,
+    },
+    /// A force plate's unloaded level drifts more than the tolerance.
+    #[error(
+        "{path}: force plate {channel}: the unloaded baseline drifts by {drift_n:.1} N over the \
+         trial (from {start_n:.1} N near frame {first_frame} to {end_n:.1} N near frame \
+         {last_frame}; tolerance {tolerance_n:.1} N); re-zero the plate, or pass \
+         --correct-drift to subtract a linear baseline fitted to the unloaded periods"
+    )]
+    PlateDrift {
+        /// The trial's source file.
+        path: String,
+        /// The plate (channel) name.
+        channel: String,
+        /// Drift over the trial, N.
+        drift_n: f64,
+        /// Baseline at the start, N.
+        start_n: f64,
+        /// Baseline at the end, N.
+        end_n: f64,
+        /// First unloaded frame used (1-based).
+        first_frame: usize,
+        /// Last unloaded frame used (1-based).
+        last_frame: usize,
+        /// The tolerance, N.
+        tolerance_n: f64,
+    },
+    /// A force plate's signal is unusable (wrong sign, never unloaded, …).
+    #[error("{path}: force plate {channel}: {message}")]
+    Plate {
+        /// The trial's source file.
+        path: String,
+        /// The plate (channel) name.
+        channel: String,
+        /// What is wrong and what to do.
+        message: String,
+    },
+    /// Invalid options (cutoff above Nyquist, unknown preset, …).
+    #[error("invalid event options: {0}")]
+    Options(String),
+    /// Reading the input failed.
+    #[error(transparent)]
+    Ingest(#[from] crate::ingest::IngestError),
+    /// Writing an output file failed.
+    #[error(transparent)]
+    Io(#[from] crate::fsio::FsError),
+    /// Writing a CSV or plot failed.
+    #[error("{path}: {message}")]
+    Write {
+        /// The file being written.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+}
+
+/// Which events the per-step table is built from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum PrimarySource {
+    /// Force-plate events when every contact of both feet falls on a plate (per-foot plates:
+    /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the Zeni coordinate method;
+    /// otherwise the file's reference events.
+    #[default]
+    Auto,
+    /// Force-plate events only.
+    Force,
+    /// Zeni coordinate method.
+    ZeniCoordinate,
+    /// Zeni velocity variant.
+    ZeniVelocity,
+    /// The events stored in the file (C3D EVENT group).
+    Reference,
+}
+
+impl PrimarySource {
+    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|reference`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
+            "auto" => Some(Self::Auto),
+            "force" => Some(Self::Force),
+            "zeni" | "zeni-coordinate" | "coordinate" | "kinematic" => Some(Self::ZeniCoordinate),
+            "zeni-velocity" | "velocity" => Some(Self::ZeniVelocity),
+            "reference" | "c3d" => Some(Self::Reference),
+            _ => None,
+        }
+    }
+}
+
+/// Every setting of event detection, with stated defaults.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EventOptions {
+    /// Force-plate thresholds and filtering.
+    pub force: force::ForceOptions,
+    /// Kinematic detection settings.
+    pub kinematic: kinematic::KinematicOptions,
+    /// Foot-phase settings.
+    pub phases: phases::PhaseOptions,
+    /// Marker roles; `None` picks the preset that matches the trial best.
+    pub markers: Option<MarkerMap>,
+    /// Which events build the steps.
+    pub primary: PrimarySource,
+    /// Walk or run, overriding the trial and the detected gait.
+    pub gait: Option<Gait>,
+    /// Treadmill or overground, overriding the trial.
+    pub setting: Option<Setting>,
+}
+
+impl Default for EventOptions {
+    fn default() -> Self {
+        EventOptions {
+            force: force::ForceOptions::default(),
+            kinematic: kinematic::KinematicOptions::default(),
+            phases: phases::PhaseOptions::default(),
+            markers: None,
+            primary: PrimarySource::Auto,
+            gait: None,
+            setting: None,
+        }
+    }
+}
+
+/// All events found in one trial, by source, and what the per-step table uses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialEvents {
+    /// The trial's source file.
+    pub path: String,
+    /// The trial's name.
+    pub trial: String,
+    /// Force-plate contacts (one per foot contact and plate; merged across plates per foot).
+    pub contacts: Vec<force::Contact>,
+    /// Force-plate events (heel strike and toe off).
+    pub force: Vec<GaitEvent>,
+    /// Whether the force events cover every contact of both feet (per-foot plates).
+    pub force_complete: bool,
+    /// Zeni coordinate-method events.
+    pub zeni_coordinate: Vec<GaitEvent>,
+    /// Zeni velocity-variant events.
+    pub zeni_velocity: Vec<GaitEvent>,
+    /// Foot-marker phases (foot flat, heel off, meta off, toe off from the foot markers).
+    pub phases: Vec<GaitEvent>,
+    /// Events read from the file (kept, never overwritten).
+    pub reference: Vec<GaitEvent>,
+    /// The source the steps are built from.
+    pub primary: EventSource,
+    /// What was assumed or found (axes, marker roles, baseline offsets, dropped events).
+    pub notes: Vec<String>,
+}
+
+impl TrialEvents {
+    /// The events of `source` (empty for a source that was not run).
+    pub fn of(&self, source: EventSource) -> &[GaitEvent] {
+        match source {
+            EventSource::Force => &self.force,
+            EventSource::ZeniCoordinate => &self.zeni_coordinate,
+            EventSource::ZeniVelocity => &self.zeni_velocity,
+            EventSource::FootMarkers => &self.phases,
+            EventSource::Reference => &self.reference,
+            EventSource::Generated => &[],
+        }
+    }
+    /// The heel-strike and toe-off events of the primary source.
+    pub fn primary_events(&self) -> &[GaitEvent] {
+        self.of(self.primary)
+    }
+}
+
+/// The trial's source path as text, for error messages.
+pub(crate) fn path_of(trial: &Trial) -> String {
+    trial.source.display().to_string()
+}
+
+/// Detects every event the trial's data allow: force-plate contacts, the two Zeni methods, the
+/// foot phases, and keeps the file's reference events; picks the primary source.
+pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventError> {
+    let path = path_of(trial);
+    let mut notes = Vec::new();
+    let kin = match &trial.markers {
+        Some(m) if !m.is_empty() => Some(kinematic::Kinematics::from_trial(
+            trial,
+            opts.markers.as_ref(),
+            &opts.kinematic,
+            opts.setting,
+        )?),
+        _ => None,
+    };
+    if let Some(k) = &kin {
+        notes.extend(k.notes.iter().cloned());
+    }
+    let fr = force::detect(trial, kin.as_ref(), &opts.force)?;
+    notes.extend(fr.notes.iter().cloned());
+    let (zc, zv) = match &kin {
+        Some(k) => (
+            k.zeni_coordinate(&opts.kinematic),
+            k.zeni_velocity(&opts.kinematic),
+        ),
+        None => (Vec::new(), Vec::new()),
+    };
+    let mut ev = TrialEvents {
+        path: path.clone(),
+        trial: trial.name.clone(),
+        contacts: fr.contacts.clone(),
+        force: fr.events.clone(),
+        force_complete: fr.complete,
+        zeni_coordinate: zc,
+        zeni_velocity: zv,
+        phases: Vec::new(),
+        reference: trial.reference_events.clone(),
+        primary: EventSource::Force,
+        notes,
+    };
+    if trial.markers.is_none() && trial.plates.is_empty() && trial.reference_events.is_empty() {
+        return Err(EventError::Missing {
+            path,
+            what: "markers, force plates and reference events: nothing to detect events from"
+                .into(),
+        });
+    }
+    ev.primary = choose_primary(&ev, opts.primary, &path)?;
+    if let Some(k) = &kin {
+        ev.phases = phases::detect(k, ev.primary_events(), &opts.phases);
+    }
+    Ok(Analysis {
+        events: ev,
+        kinematics: kin,
+        force: fr,
+    })
+}
+
+/// The events of every source found in `trial` (see [`analyse`]).
+pub fn detect(trial: &Trial, opts: &EventOptions) -> Result<TrialEvents, EventError> {
+    analyse(trial, opts).map(|a| a.events)
+}
+
+fn has_both_kinds(ev: &[GaitEvent]) -> bool {
+    ev.iter().any(|e| e.kind == EventKind::HeelStrike)
+        && ev.iter().any(|e| e.kind == EventKind::ToeOff)
+}
+
+fn choose_primary(
+    ev: &TrialEvents,
+    want: PrimarySource,
+    path: &str,
+) -> Result<EventSource, EventError> {
+    let need = |src: EventSource, what: &str| -> Result<EventSource, EventError> {
+        if has_both_kinds(ev.of(src)) {
+            Ok(src)
+        } else {
+            Err(EventError::NoEvents {
+                path: path.to_string(),
+                reason: format!("{what} found no heel strike and toe off"),
+            })
+        }
+    };
+    match want {
+        PrimarySource::Force => need(EventSource::Force, "the force plates"),
+        PrimarySource::ZeniCoordinate => {
+            need(EventSource::ZeniCoordinate, "the Zeni coordinate method")
+        }
+        PrimarySource::ZeniVelocity => need(EventSource::ZeniVelocity, "the Zeni velocity method"),
+        PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
+        PrimarySource::Auto => {
+            if ev.force_complete && has_both_kinds(&ev.force) {
+                Ok(EventSource::Force)
+            } else if has_both_kinds(&ev.zeni_coordinate) {
+                Ok(EventSource::ZeniCoordinate)
+            } else if has_both_kinds(&ev.reference) {
+                Ok(EventSource::Reference)
+            } else if has_both_kinds(&ev.force) {
+                Ok(EventSource::Force)
+            } else {
+                Err(EventError::NoEvents {
+                    path: path.to_string(),
+                    reason: "neither the force plates nor the foot markers show a heel strike \
+                             followed by a toe off (a standing trial?)"
+                        .into(),
+                })
+            }
+        }
+    }
+}
+
+/// Detects the events of `trial` and builds its per-step table (see [`steps`]).
+pub fn steps_from_trial(trial: &Trial, opts: &EventOptions) -> Result<StepTable, EventError> {
+    let an = analyse(trial, opts)?;
+    steps_from_analysis(trial, &an, opts)
 }

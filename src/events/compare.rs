@@ -1,0 +1,266 @@
+//! How well one event source agrees with another: detection F1 with a matching tolerance, and
+//! the timing error (detected − reference, mean ± SD, ms) of the matched events, per event kind.
+//!
+//! Matching is one-to-one per foot and event kind: pairs closer than the tolerance (default
+//! 60 ms, about a quarter of a running contact) are matched greedily, closest first.
+//!
+//! What can be judged depends on how complete the reference is:
+//! - [`Coverage::Complete`]: the reference sees every contact (per-foot plates of a dual-belt
+//!   treadmill or an OpenSim GRF file): every detected event inside the reference record counts;
+//! - [`Coverage::Window`]: the reference marks every event within a window (a C3D's events):
+//!   detected events outside `[first − tol, last + tol]` of that foot and kind are ignored;
+//! - [`Coverage::MatchedOnly`]: the reference sees only some contacts (overground plates): an
+//!   unmatched detected event may be a step beside the plates, so precision and F1 are not
+//!   defined; the recall and the timing error are.
+use super::{EventKind, GaitEvent, Side};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Default matching tolerance, s.
+pub const DEFAULT_TOLERANCE_S: f64 = 0.06;
+
+/// How complete the reference events are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Coverage {
+    /// Every event within `[start, end]` of the record (s).
+    Complete,
+    /// Every event between the first and the last reference event of each foot and kind.
+    Window,
+    /// Only some events (precision not assessable).
+    MatchedOnly,
+}
+
+/// Match counts and timing errors of one event kind (one method, one reference).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct KindCounts {
+    /// Matched pairs.
+    pub tp: usize,
+    /// Detected events without a reference partner (counted only where assessable).
+    pub fp: usize,
+    /// Reference events without a detected partner.
+    pub fn_: usize,
+    /// Whether false positives could be assessed for every contribution.
+    pub precision_assessable: bool,
+    /// Timing errors of the matched pairs, detected − reference, s.
+    pub errors_s: Vec<f64>,
+}
+
+impl KindCounts {
+    /// Recall = tp / (tp + fn).
+    pub fn recall(&self) -> Option<f64> {
+        let d = self.tp + self.fn_;
+        (d > 0).then(|| self.tp as f64 / d as f64)
+    }
+    /// Precision = tp / (tp + fp), when assessable.
+    pub fn precision(&self) -> Option<f64> {
+        let d = self.tp + self.fp;
+        (self.precision_assessable && d > 0).then(|| self.tp as f64 / d as f64)
+    }
+    /// F1 = 2·tp / (2·tp + fp + fn), when precision is assessable.
+    pub fn f1(&self) -> Option<f64> {
+        let d = 2 * self.tp + self.fp + self.fn_;
+        (self.precision_assessable && d > 0).then(|| 2.0 * self.tp as f64 / d as f64)
+    }
+    /// Mean timing error, ms.
+    pub fn mean_ms(&self) -> Option<f64> {
+        let n = self.errors_s.len();
+        (n > 0).then(|| self.errors_s.iter().sum::<f64>() / n as f64 * 1000.0)
+    }
+    /// Sample standard deviation of the timing error, ms.
+    pub fn sd_ms(&self) -> Option<f64> {
+        let n = self.errors_s.len();
+        if n < 2 {
+            return None;
+        }
+        let m = self.errors_s.iter().sum::<f64>() / n as f64;
+        let v = self.errors_s.iter().map(|e| (e - m) * (e - m)).sum::<f64>() / (n - 1) as f64;
+        Some(v.sqrt() * 1000.0)
+    }
+    /// Adds another count.
+    pub fn merge(&mut self, other: &KindCounts) {
+        if self.tp + self.fp + self.fn_ == 0 && self.errors_s.is_empty() {
+            self.precision_assessable = other.precision_assessable;
+        } else {
+            self.precision_assessable &= other.precision_assessable;
+        }
+        self.tp += other.tp;
+        self.fp += other.fp;
+        self.fn_ += other.fn_;
+        self.errors_s.extend_from_slice(&other.errors_s);
+    }
+}
+
+/// Compares `detected` with `reference` for every event kind present in the reference. `span`
+/// is the time interval both sources cover (events outside it are ignored).
+pub fn compare(
+    detected: &[GaitEvent],
+    reference: &[GaitEvent],
+    coverage: Coverage,
+    span: (f64, f64),
+    tol_s: f64,
+) -> BTreeMap<EventKind, KindCounts> {
+    let mut out: BTreeMap<EventKind, KindCounts> = BTreeMap::new();
+    let kinds: Vec<EventKind> = {
+        let mut k: Vec<EventKind> = reference.iter().map(|e| e.kind).collect();
+        k.sort();
+        k.dedup();
+        k
+    };
+    for kind in kinds {
+        let counts = out.entry(kind).or_insert_with(|| KindCounts {
+            precision_assessable: coverage != Coverage::MatchedOnly,
+            ..KindCounts::default()
+        });
+        for side in [Side::Left, Side::Right] {
+            let inside = |e: &&GaitEvent| {
+                e.kind == kind && e.side == side && e.time_s >= span.0 && e.time_s <= span.1
+            };
+            let refs: Vec<f64> = reference.iter().filter(inside).map(|e| e.time_s).collect();
+            let mut det: Vec<f64> = detected.iter().filter(inside).map(|e| e.time_s).collect();
+            if coverage == Coverage::Window {
+                if refs.is_empty() {
+                    continue;
+                }
+                let lo = refs.iter().copied().fold(f64::INFINITY, f64::min) - tol_s;
+                let hi = refs.iter().copied().fold(f64::NEG_INFINITY, f64::max) + tol_s;
+                det.retain(|&t| t >= lo && t <= hi);
+            }
+            let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+            for (i, &d) in det.iter().enumerate() {
+                for (j, &r) in refs.iter().enumerate() {
+                    if (d - r).abs() <= tol_s {
+                        pairs.push(((d - r).abs(), i, j));
+                    }
+                }
+            }
+            pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut used_d = vec![false; det.len()];
+            let mut used_r = vec![false; refs.len()];
+            for (_, i, j) in pairs {
+                if used_d[i] || used_r[j] {
+                    continue;
+                }
+                used_d[i] = true;
+                used_r[j] = true;
+                counts.tp += 1;
+                counts.errors_s.push(det[i] - refs[j]);
+            }
+            counts.fn_ += used_r.iter().filter(|u| !**u).count();
+            if coverage != Coverage::MatchedOnly {
+                counts.fp += used_d.iter().filter(|u| !**u).count();
+            }
+        }
+    }
+    out
+}
+
+/// A table of comparisons accumulated over trials: `(method, reference, kind) → counts`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CompareTable {
+    /// The accumulated counts.
+    pub rows: BTreeMap<(String, String, EventKind), KindCounts>,
+}
+
+impl CompareTable {
+    /// Adds the result of one [`compare`] call.
+    pub fn add(&mut self, method: &str, reference: &str, res: &BTreeMap<EventKind, KindCounts>) {
+        for (kind, c) in res {
+            self.rows
+                .entry((method.to_string(), reference.to_string(), *kind))
+                .or_default()
+                .merge(c);
+        }
+    }
+
+    /// Adds every row of another table.
+    pub fn merge(&mut self, other: &CompareTable) {
+        for (k, c) in &other.rows {
+            self.rows.entry(k.clone()).or_default().merge(c);
+        }
+    }
+
+    /// A plain-text table: method, reference, event, n, F1, recall, mean ± SD (ms).
+    pub fn render(&self) -> String {
+        let mut s = format!(
+            "{:<16} {:<10} {:<12} {:>5} {:>6} {:>7} {:>17}\n",
+            "method", "vs", "event", "n", "F1", "recall", "error ms (mean±SD)"
+        );
+        let f = |v: Option<f64>, d: usize| v.map(|x| format!("{x:.d$}")).unwrap_or("–".into());
+        for ((m, r, k), c) in &self.rows {
+            s.push_str(&format!(
+                "{:<16} {:<10} {:<12} {:>5} {:>6} {:>7} {:>9} ± {:<6}\n",
+                m,
+                r,
+                k.as_str(),
+                c.tp,
+                f(c.f1(), 3),
+                f(c.recall(), 3),
+                f(c.mean_ms(), 1),
+                f(c.sd_ms(), 1)
+            ));
+        }
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::EventSource;
+
+    fn hs(t: f64, side: Side) -> GaitEvent {
+        GaitEvent {
+            time_s: t,
+            side,
+            kind: EventKind::HeelStrike,
+            source: EventSource::Force,
+        }
+    }
+
+    #[test]
+    fn f1_and_timing() {
+        let r = vec![
+            hs(1.0, Side::Left),
+            hs(2.0, Side::Left),
+            hs(3.0, Side::Left),
+        ];
+        let d = vec![
+            hs(1.01, Side::Left),
+            hs(2.03, Side::Left),
+            hs(2.5, Side::Left),
+            hs(1.0, Side::Right),
+        ];
+        let c = compare(&d, &r, Coverage::Complete, (0.0, 10.0), 0.06);
+        let k = &c[&EventKind::HeelStrike];
+        assert_eq!((k.tp, k.fp, k.fn_), (2, 2, 1));
+        assert!((k.f1().unwrap() - 4.0 / 7.0).abs() < 1e-12);
+        assert!((k.mean_ms().unwrap() - 20.0).abs() < 1e-9);
+        assert!((k.sd_ms().unwrap() - (200.0f64).sqrt()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn window_and_matched_only() {
+        let r = vec![hs(2.0, Side::Left)];
+        let d = vec![
+            hs(1.0, Side::Left),
+            hs(2.01, Side::Left),
+            hs(3.0, Side::Left),
+        ];
+        let w = compare(&d, &r, Coverage::Window, (0.0, 10.0), 0.06);
+        assert_eq!(w[&EventKind::HeelStrike].fp, 0);
+        assert_eq!(w[&EventKind::HeelStrike].f1(), Some(1.0));
+        let m = compare(&d, &r, Coverage::MatchedOnly, (0.0, 10.0), 0.06);
+        assert_eq!(m[&EventKind::HeelStrike].f1(), None);
+        assert_eq!(m[&EventKind::HeelStrike].recall(), Some(1.0));
+    }
+
+    #[test]
+    fn one_to_one_matching_prefers_closest() {
+        let r = vec![hs(1.0, Side::Left)];
+        let d = vec![hs(0.97, Side::Left), hs(1.01, Side::Left)];
+        let c = compare(&d, &r, Coverage::Complete, (0.0, 10.0), 0.06);
+        let k = &c[&EventKind::HeelStrike];
+        assert_eq!((k.tp, k.fp), (1, 1));
+        assert!((k.errors_s[0] - 0.01).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,686 @@
+//! Heel strike and toe off from the vertical ground reaction force.
+//!
+//! Per plate: the vertical force is low-pass filtered (zero-phase Butterworth, default order 2 at
+//! 20 Hz), its unloaded baseline is measured on the unloaded samples and removed (an offset is
+//! noted; a drift above the tolerance is an error unless drift correction is asked for), then a
+//! threshold with hysteresis finds the contacts: a contact starts when the force exceeds
+//! `on_n` (default 50 N) and ends when it falls below `off_n` (default 20 N). Both events are
+//! timed where the force crosses `off_n` (linear interpolation between samples): the higher
+//! level only confirms that a real contact, not noise, began.
+//!
+//! Plates that carry one known foot (dual-belt treadmill belts, OpenSim `R_`/`L_` forces) give
+//! that foot's events directly. Overground plates (`side: None`) are assigned to a foot by the
+//! markers (the foot whose heel–metatarsal midpoint is nearest to the centre of pressure at
+//! mid-contact), or, without markers, by alternation in time; contacts of one foot on
+//! neighbouring plates are merged.
+use super::filter::{filtfilt_gappy, Butterworth};
+use super::kinematic::Kinematics;
+use super::{path_of, EventError, EventKind, EventSource, GaitEvent, Side};
+use crate::ingest::types::{ForcePlate, Trial};
+use serde::{Deserialize, Serialize};
+
+/// Force-event settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ForceOptions {
+    /// Low-pass cutoff, Hz (default 20).
+    pub cutoff_hz: f64,
+    /// Butterworth order of one pass (default 2; zero-phase doubles it).
+    pub order: usize,
+    /// Contact-on threshold, N (default 50).
+    pub on_n: f64,
+    /// Contact-off threshold, N (default 20); events are timed at this level.
+    pub off_n: f64,
+    /// Shortest contact kept, s (default 0.05): shorter ones are noise or a brush of the plate.
+    pub min_contact_s: f64,
+    /// Shortest unloaded gap between two contacts of one plate, s (default 0.05): shorter gaps
+    /// are merged (a dip of the force under the threshold inside one contact).
+    pub min_gap_s: f64,
+    /// Largest baseline drift tolerated without correction, N (default 10).
+    pub drift_tolerance_n: f64,
+    /// Subtract a linear baseline fitted to the unloaded periods instead of failing on drift.
+    pub correct_drift: bool,
+}
+
+impl Default for ForceOptions {
+    fn default() -> Self {
+        ForceOptions {
+            cutoff_hz: 20.0,
+            order: 2,
+            on_n: 50.0,
+            off_n: 20.0,
+            min_contact_s: 0.05,
+            min_gap_s: 0.05,
+            drift_tolerance_n: 10.0,
+            correct_drift: false,
+        }
+    }
+}
+
+/// One foot contact seen by the force plates.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Contact {
+    /// Names of the plates it was seen on.
+    pub plates: Vec<String>,
+    /// The foot (known from the plate, or assigned).
+    pub side: Side,
+    /// How the foot was assigned ("plate", "markers", "alternation").
+    pub assigned_by: String,
+    /// Start, s (`None` when the record starts loaded: the heel strike was not seen).
+    pub on_s: Option<f64>,
+    /// End, s (`None` when the record ends loaded).
+    pub off_s: Option<f64>,
+    /// First and last sample of the contact (time, s).
+    pub span_s: (f64, f64),
+    /// Peak vertical force, N.
+    pub peak_n: f64,
+    /// Mean centre of pressure over the loaded part of the contact (force above 20 % of its
+    /// peak; laboratory frame, m), when known.
+    pub cop_m: Option<[f64; 3]>,
+    /// Mean time of the samples averaged into `cop_m`, s.
+    pub cop_time_mean_s: Option<f64>,
+    /// Velocity of the centre of pressure over those samples (least-squares slope per axis),
+    /// m/s.
+    pub cop_slope: Option<[f64; 3]>,
+}
+
+/// Per-plate diagnostics.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PlateReport {
+    /// Plate name.
+    pub name: String,
+    /// Baseline removed (mean unloaded level), N.
+    pub offset_n: f64,
+    /// Baseline drift over the trial (end − start of the fitted line), N.
+    pub drift_n: f64,
+    /// Number of contacts found.
+    pub contacts: usize,
+}
+
+/// The filtered, baseline-corrected vertical force of one plate.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct VerticalForce {
+    /// Plate name.
+    pub name: String,
+    /// The foot it carries, if known.
+    pub side: Option<Side>,
+    /// Sample times, s.
+    pub time_s: Vec<f64>,
+    /// Vertical force, N.
+    pub force_n: Vec<f64>,
+}
+
+/// The force-plate result of one trial.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+pub struct ForceResult {
+    /// Contacts, per foot, in time order.
+    pub contacts: Vec<Contact>,
+    /// Heel strike and toe off of every contact whose start/end was seen.
+    pub events: Vec<GaitEvent>,
+    /// True when every plate carries one known foot (all contacts of both feet are seen).
+    pub complete: bool,
+    /// Per-plate diagnostics.
+    pub plates: Vec<PlateReport>,
+    /// The processed vertical forces (for plots).
+    pub vertical: Vec<VerticalForce>,
+    /// What was found or assumed.
+    pub notes: Vec<String>,
+}
+
+/// The index of the vertical axis of the trial (its frame, else Y, the OpenSim and treadmill
+/// convention of the shared data).
+fn vertical_axis(trial: &Trial) -> usize {
+    trial
+        .frame
+        .as_ref()
+        .map(|f| f.vertical.index())
+        .unwrap_or(1)
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let k = ((sorted.len() - 1) as f64 * p).round() as usize;
+    sorted[k.min(sorted.len() - 1)]
+}
+
+/// Filters the vertical force of `plate` and removes its unloaded baseline.
+pub fn vertical_force(
+    plate: &ForcePlate,
+    axis: usize,
+    path: &str,
+    opts: &ForceOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Vec<f64>, PlateReport), EventError> {
+    let raw: Vec<f64> = plate.force_n.iter().map(|f| f[axis]).collect();
+    let n = raw.len();
+    let plate_err = |message: String| EventError::Plate {
+        path: path.to_string(),
+        channel: plate.name.clone(),
+        message,
+    };
+    if n != plate.time_s.len() {
+        return Err(plate_err(format!(
+            "{} force samples but {} sample times",
+            n,
+            plate.time_s.len()
+        )));
+    }
+    let filter = Butterworth::low_pass(opts.order, opts.cutoff_hz, plate.rate_hz)?;
+    if n < filter.min_len() {
+        return Err(EventError::TooShort {
+            path: path.to_string(),
+            reason: format!("force plate {} has only {n} samples", plate.name),
+        });
+    }
+    let mut f = filtfilt_gappy(&filter, &raw);
+    let mut sorted: Vec<f64> = f.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    let (p2, p98) = (percentile(&sorted, 0.02), percentile(&sorted, 0.98));
+    let mut report = PlateReport {
+        name: plate.name.clone(),
+        offset_n: 0.0,
+        drift_n: 0.0,
+        contacts: 0,
+    };
+    if sorted.is_empty() {
+        return Ok((f, report));
+    }
+    if p98 < opts.on_n && p2 < -opts.on_n {
+        return Err(plate_err(format!(
+            "the vertical force is negative (down to {p2:.0} N): the file gives the force on \
+             the plate, not on the body; flip the sign of the vertical channel"
+        )));
+    }
+    if p98 < opts.on_n {
+        // Never loaded: nobody stepped on this plate.
+        return Ok((f, report));
+    }
+    if p2 > 0.25 * p98 {
+        return Err(plate_err(format!(
+            "never unloaded (lowest force {p2:.0} N, peak {p98:.0} N): a single belt carrying \
+             both feet cannot be split into foot contacts; use markers (--events zeni) or \
+             per-belt forces"
+        )));
+    }
+    // Unloaded samples: within `off_n` of the lowest level.
+    let unloaded: Vec<usize> = (0..n)
+        .filter(|&i| f[i].is_finite() && f[i] < p2 + opts.off_n)
+        .collect();
+    if unloaded.len() >= 10 {
+        let t: Vec<f64> = unloaded.iter().map(|&i| plate.time_s[i]).collect();
+        let y: Vec<f64> = unloaded.iter().map(|&i| f[i]).collect();
+        let m = t.len() as f64;
+        let (tm, ym) = (t.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
+        let sxx: f64 = t.iter().map(|v| (v - tm) * (v - tm)).sum();
+        let sxy: f64 = t.iter().zip(&y).map(|(a, b)| (a - tm) * (b - ym)).sum();
+        let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+        let (t0, t1) = (plate.time_s[0], plate.time_s[n - 1]);
+        let start = ym + slope * (t0 - tm);
+        let end = ym + slope * (t1 - tm);
+        report.offset_n = ym;
+        report.drift_n = end - start;
+        if report.drift_n.abs() > opts.drift_tolerance_n {
+            if !opts.correct_drift {
+                return Err(EventError::PlateDrift {
+                    path: path.to_string(),
+                    channel: plate.name.clone(),
+                    drift_n: report.drift_n,
+                    start_n: start,
+                    end_n: end,
+                    first_frame: unloaded[0] + 1,
+                    last_frame: unloaded[unloaded.len() - 1] + 1,
+                    tolerance_n: opts.drift_tolerance_n,
+                });
+            }
+            for (v, &ti) in f.iter_mut().zip(&plate.time_s) {
+                *v -= ym + slope * (ti - tm);
+            }
+            notes.push(format!(
+                "force plate {}: baseline drift of {:.1} N over the trial subtracted (linear fit \
+                 to {} unloaded samples)",
+                plate.name,
+                report.drift_n,
+                unloaded.len()
+            ));
+        } else {
+            for v in f.iter_mut() {
+                *v -= ym;
+            }
+            if ym.abs() > 2.0 {
+                notes.push(format!(
+                    "force plate {}: unloaded offset of {ym:.1} N removed (mean of {} unloaded \
+                     samples); drift {:.1} N is within tolerance",
+                    plate.name,
+                    unloaded.len(),
+                    report.drift_n
+                ));
+            }
+        }
+    }
+    Ok((f, report))
+}
+
+/// Raw contacts (`(start index, end index, on time, off time)`) of one filtered force signal by
+/// threshold with hysteresis. `on`/`off` times are `None` when the record starts/ends loaded.
+fn threshold_contacts(
+    t: &[f64],
+    f: &[f64],
+    opts: &ForceOptions,
+) -> Vec<(usize, usize, Option<f64>, Option<f64>)> {
+    let n = f.len();
+    let cross = |i: usize, level: f64| -> f64 {
+        // Time between samples i and i+1 where the force crosses `level`.
+        let (a, b) = (f[i], f[i + 1]);
+        if (b - a).abs() < 1e-12 {
+            t[i]
+        } else {
+            t[i] + (level - a) / (b - a) * (t[i + 1] - t[i])
+        }
+    };
+    let mut out: Vec<(usize, usize, Option<f64>, Option<f64>)> = Vec::new();
+    let mut i = 0;
+    while i < n {
+        if f[i].is_nan() || f[i] <= opts.on_n {
+            i += 1;
+            continue;
+        }
+        // Walk back to where the force last rose through off_n.
+        let mut s = i;
+        while s > 0 && f[s - 1].is_finite() && f[s - 1] >= opts.off_n {
+            s -= 1;
+        }
+        let on = if s == 0 || !f[s - 1].is_finite() {
+            None
+        } else {
+            Some(cross(s - 1, opts.off_n))
+        };
+        let mut e = i;
+        while e + 1 < n && f[e + 1].is_finite() && f[e + 1] >= opts.off_n {
+            e += 1;
+        }
+        let off = if e + 1 >= n || !f[e + 1].is_finite() {
+            None
+        } else {
+            Some(cross(e, opts.off_n))
+        };
+        out.push((s, e, on, off));
+        i = e + 1;
+    }
+    // Merge contacts separated by a short gap; drop short ones (unless truncated by the record).
+    let mut merged: Vec<(usize, usize, Option<f64>, Option<f64>)> = Vec::new();
+    for c in out {
+        if let Some(last) = merged.last_mut() {
+            if t[c.0] - t[last.1] < opts.min_gap_s {
+                last.1 = c.1;
+                last.3 = c.3;
+                continue;
+            }
+        }
+        merged.push(c);
+    }
+    merged
+        .into_iter()
+        .filter(|c| c.2.is_none() || c.3.is_none() || t[c.1] - t[c.0] >= opts.min_contact_s)
+        .collect()
+}
+
+/// Mean centre of pressure, its mean time and its velocity over the samples `s..=e` whose
+/// force exceeds 20 % of `peak` (the centre of pressure is meaningless under a light load).
+#[allow(clippy::type_complexity)]
+fn cop_stats(
+    plate: &ForcePlate,
+    f: &[f64],
+    s: usize,
+    e: usize,
+    peak: f64,
+) -> (Option<[f64; 3]>, Option<f64>, Option<[f64; 3]>) {
+    let idx: Vec<usize> = (s..=e)
+        .filter(|&i| {
+            f[i] > 0.2 * peak
+                && plate
+                    .cop_m
+                    .get(i)
+                    .is_some_and(|c| c.iter().all(|v| v.is_finite()))
+        })
+        .collect();
+    if idx.len() < 3 {
+        return (None, None, None);
+    }
+    let m = idx.len() as f64;
+    let tm = idx.iter().map(|&i| plate.time_s[i]).sum::<f64>() / m;
+    let mut mean = [0.0; 3];
+    for &i in &idx {
+        for (mv, c) in mean.iter_mut().zip(plate.cop_m[i]) {
+            *mv += c / m;
+        }
+    }
+    let sxx: f64 = idx.iter().map(|&i| (plate.time_s[i] - tm).powi(2)).sum();
+    let mut slope = [0.0; 3];
+    if sxx > 0.0 {
+        for (a, sl) in slope.iter_mut().enumerate() {
+            let sxy: f64 = idx
+                .iter()
+                .map(|&i| (plate.time_s[i] - tm) * (plate.cop_m[i][a] - mean[a]))
+                .sum();
+            *sl = sxy / sxx;
+        }
+    }
+    (Some(mean), Some(tm), Some(slope))
+}
+
+/// Finds the contacts and events of every plate of `trial`; `kin` (when the trial has markers)
+/// assigns overground contacts to a foot.
+pub fn detect(
+    trial: &Trial,
+    kin: Option<&Kinematics>,
+    opts: &ForceOptions,
+) -> Result<ForceResult, EventError> {
+    let path = path_of(trial);
+    let axis = vertical_axis(trial);
+    let mut res = ForceResult::default();
+    if trial.plates.is_empty() {
+        return Ok(res);
+    }
+    if !(opts.on_n > opts.off_n && opts.off_n > 0.0) {
+        return Err(EventError::Options(format!(
+            "force thresholds: on ({} N) must exceed off ({} N) > 0",
+            opts.on_n, opts.off_n
+        )));
+    }
+    let mut unassigned: Vec<Contact> = Vec::new();
+    for plate in &trial.plates {
+        let (f, mut report) = vertical_force(plate, axis, &path, opts, &mut res.notes)?;
+        let raw = threshold_contacts(&plate.time_s, &f, opts);
+        report.contacts = raw.len();
+        for (s, e, on, off) in raw {
+            let peak = f[s..=e].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let (cop, cop_t, cop_slope) = cop_stats(plate, &f, s, e, peak);
+            let c = Contact {
+                plates: vec![plate.name.clone()],
+                side: plate.side.unwrap_or(Side::Right),
+                assigned_by: "plate".into(),
+                on_s: on,
+                off_s: off,
+                span_s: (plate.time_s[s], plate.time_s[e]),
+                peak_n: peak,
+                cop_m: cop,
+                cop_time_mean_s: cop_t,
+                cop_slope,
+            };
+            if plate.side.is_some() {
+                res.contacts.push(c);
+            } else {
+                unassigned.push(c);
+            }
+        }
+        res.vertical.push(VerticalForce {
+            name: plate.name.clone(),
+            side: plate.side,
+            time_s: plate.time_s.clone(),
+            force_n: f,
+        });
+        res.plates.push(report);
+    }
+    res.complete = trial.plates.iter().all(|p| p.side.is_some())
+        && [Side::Left, Side::Right]
+            .iter()
+            .all(|s| trial.plates.iter().any(|p| p.side == Some(*s)));
+    if !unassigned.is_empty() {
+        assign_feet(&mut unassigned, kin, &mut res.notes);
+        res.contacts.extend(unassigned);
+    }
+    res.contacts = merge_same_foot(std::mem::take(&mut res.contacts));
+    for c in &res.contacts {
+        if let Some(t) = c.on_s {
+            res.events.push(GaitEvent {
+                time_s: t,
+                side: c.side,
+                kind: EventKind::HeelStrike,
+                source: EventSource::Force,
+            });
+        }
+        if let Some(t) = c.off_s {
+            res.events.push(GaitEvent {
+                time_s: t,
+                side: c.side,
+                kind: EventKind::ToeOff,
+                source: EventSource::Force,
+            });
+        }
+    }
+    res.events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    Ok(res)
+}
+
+/// Assigns overground contacts to a foot: by the markers when there are any, else by
+/// alternation in time.
+fn assign_feet(contacts: &mut [Contact], kin: Option<&Kinematics>, notes: &mut Vec<String>) {
+    contacts.sort_by(|a, b| a.span_s.0.total_cmp(&b.span_s.0));
+    let mut by_markers = 0;
+    if let Some(k) = kin {
+        for c in contacts.iter_mut() {
+            let mid = 0.5 * (c.span_s.0 + c.span_s.1);
+            if let Some(side) = k.foot_nearest(mid, c.cop_m) {
+                c.side = side;
+                c.assigned_by = "markers".into();
+                by_markers += 1;
+            }
+        }
+    }
+    if by_markers == contacts.len() {
+        return;
+    }
+    // Alternation: contacts that overlap in time by more than half the shorter one are one foot
+    // on two plates; otherwise consecutive contacts belong to alternate feet.
+    let mut side = Side::Right;
+    let mut prev: Option<(f64, f64)> = None;
+    for c in contacts.iter_mut() {
+        if let Some((a, b)) = prev {
+            let overlap = (b.min(c.span_s.1) - a.max(c.span_s.0)).max(0.0);
+            let shorter = (b - a).min(c.span_s.1 - c.span_s.0).max(1e-9);
+            if overlap <= 0.5 * shorter {
+                side = side.opposite();
+            }
+        }
+        if c.assigned_by != "markers" {
+            c.side = side;
+            c.assigned_by = "alternation".into();
+        }
+        prev = Some(c.span_s);
+    }
+    notes.push(
+        "overground force plates without markers: contacts assigned to the feet by alternation, \
+         the first to the right foot (pass markers to assign by foot position)"
+            .into(),
+    );
+}
+
+/// Merges contacts of the same foot that overlap in time (one foot on two plates).
+fn merge_same_foot(mut contacts: Vec<Contact>) -> Vec<Contact> {
+    contacts.sort_by(|a, b| {
+        (a.side, a.span_s.0)
+            .partial_cmp(&(b.side, b.span_s.0))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    let mut out: Vec<Contact> = Vec::new();
+    for c in contacts {
+        if let Some(last) = out.last_mut() {
+            if last.side == c.side && c.span_s.0 <= last.span_s.1 {
+                last.plates.extend(c.plates);
+                last.on_s = match (last.on_s, c.on_s) {
+                    (Some(a), Some(b)) => Some(a.min(b)),
+                    _ => None,
+                };
+                if c.span_s.1 >= last.span_s.1 {
+                    last.off_s = c.off_s;
+                }
+                last.span_s = (last.span_s.0.min(c.span_s.0), last.span_s.1.max(c.span_s.1));
+                last.peak_n = last.peak_n.max(c.peak_n);
+                continue;
+            }
+        }
+        out.push(c);
+    }
+    out.sort_by(|a, b| a.span_s.0.total_cmp(&b.span_s.0));
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A synthetic vertical force: half-sine contacts of `peak` N.
+    fn plate(side: Option<Side>, contacts: &[(f64, f64)], rate: f64, dur: f64) -> ForcePlate {
+        let n = (dur * rate) as usize;
+        let time_s: Vec<f64> = (0..n).map(|i| i as f64 / rate).collect();
+        let force_n = time_s
+            .iter()
+            .map(|&t| {
+                let mut fy = 0.0;
+                for &(a, b) in contacts {
+                    if t > a && t < b {
+                        fy += 800.0 * (std::f64::consts::PI * (t - a) / (b - a)).sin();
+                    }
+                }
+                [0.0, fy, 0.0]
+            })
+            .collect();
+        ForcePlate {
+            name: "FP".into(),
+            rate_hz: rate,
+            cop_m: vec![[f64::NAN; 3]; n],
+            time_s,
+            force_n,
+            free_moment_nm: vec![],
+            side,
+        }
+    }
+
+    fn trial(plates: Vec<ForcePlate>) -> Trial {
+        let mut t = Trial::new("synthetic.mot", "synthetic");
+        t.plates = plates;
+        t
+    }
+
+    #[test]
+    fn events_near_true_contact_times() {
+        // A half-sine of 800 N crosses 20 N at 0.8 % of the contact: 2.5 ms after 0.3 s for a
+        // 0.25 s contact; filtering at 20 Hz rounds the corner a little more.
+        let p = plate(Some(Side::Right), &[(0.3, 0.55), (1.0, 1.25)], 1000.0, 2.0);
+        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        let hs: Vec<f64> = r
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::HeelStrike)
+            .map(|e| e.time_s)
+            .collect();
+        let to: Vec<f64> = r
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::ToeOff)
+            .map(|e| e.time_s)
+            .collect();
+        assert_eq!(hs.len(), 2);
+        assert_eq!(to.len(), 2);
+        assert!((hs[0] - 0.3).abs() < 0.006, "{hs:?}");
+        assert!((to[1] - 1.25).abs() < 0.006, "{to:?}");
+        assert!(r.events.iter().all(|e| e.side == Side::Right));
+    }
+
+    #[test]
+    fn truncated_contact_has_no_heel_strike() {
+        let p = plate(Some(Side::Left), &[(-0.1, 0.2), (0.7, 0.95)], 500.0, 1.5);
+        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        assert_eq!(r.contacts.len(), 2);
+        assert!(r.contacts[0].on_s.is_none());
+        assert!(r.contacts[0].off_s.is_some());
+        let n_hs = r
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::HeelStrike)
+            .count();
+        assert_eq!(n_hs, 1);
+    }
+
+    #[test]
+    fn offset_is_removed_and_reported() {
+        let mut p = plate(Some(Side::Right), &[(0.3, 0.55), (1.0, 1.25)], 1000.0, 2.0);
+        for f in p.force_n.iter_mut() {
+            f[1] += 35.0;
+        }
+        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        assert!((r.plates[0].offset_n - 35.0).abs() < 1.0);
+        assert!(r.notes.iter().any(|n| n.contains("offset")));
+        let hs = r
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::HeelStrike)
+            .unwrap();
+        assert!((hs.time_s - 0.3).abs() < 0.006);
+    }
+
+    #[test]
+    fn drift_is_an_error_naming_the_channel_unless_corrected() {
+        let mut p = plate(Some(Side::Right), &[(0.3, 0.55), (1.0, 1.25)], 1000.0, 2.0);
+        for (f, t) in p.force_n.iter_mut().zip(p.time_s.clone()) {
+            f[1] += 15.0 * t;
+        }
+        let err = detect(&trial(vec![p.clone()]), None, &ForceOptions::default()).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("synthetic.mot") && msg.contains("FP") && msg.contains("drift"));
+        let opts = ForceOptions {
+            correct_drift: true,
+            ..ForceOptions::default()
+        };
+        let r = detect(&trial(vec![p]), None, &opts).unwrap();
+        assert!((r.plates[0].drift_n - 30.0).abs() < 2.0);
+        assert_eq!(r.events.len(), 4);
+    }
+
+    #[test]
+    fn negative_force_and_never_unloaded_are_errors() {
+        let mut p = plate(Some(Side::Right), &[(0.3, 0.55)], 1000.0, 1.0);
+        for f in p.force_n.iter_mut() {
+            f[1] = -f[1];
+        }
+        assert!(detect(&trial(vec![p]), None, &ForceOptions::default())
+            .unwrap_err()
+            .to_string()
+            .contains("flip"));
+        let mut p = plate(Some(Side::Right), &[(0.3, 0.55)], 1000.0, 1.0);
+        for f in p.force_n.iter_mut() {
+            f[1] += 600.0;
+        }
+        assert!(detect(&trial(vec![p]), None, &ForceOptions::default())
+            .unwrap_err()
+            .to_string()
+            .contains("never unloaded"));
+    }
+
+    #[test]
+    fn overground_plates_alternate_and_merge() {
+        // Foot 1 on plate A then B (overlapping: straddles), foot 2 on plate C.
+        let mut a = plate(None, &[(0.2, 0.8)], 500.0, 2.0);
+        a.name = "A".into();
+        let mut b = plate(None, &[(0.5, 0.85)], 500.0, 2.0);
+        b.name = "B".into();
+        let mut c = plate(None, &[(0.75, 1.4)], 500.0, 2.0);
+        c.name = "C".into();
+        let r = detect(&trial(vec![a, b, c]), None, &ForceOptions::default()).unwrap();
+        assert!(!r.complete);
+        assert_eq!(r.contacts.len(), 2, "{:?}", r.contacts);
+        assert_ne!(r.contacts[0].side, r.contacts[1].side);
+        assert_eq!(r.contacts[0].plates.len(), 2);
+    }
+
+    #[test]
+    fn noise_spike_is_not_a_contact() {
+        let mut p = plate(Some(Side::Right), &[(0.3, 0.55)], 1000.0, 1.0);
+        for i in 800..815 {
+            p.force_n[i][1] = 400.0; // 15 ms spike
+        }
+        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        assert_eq!(r.contacts.len(), 1);
+    }
+}

@@ -1,0 +1,1 @@
+//! Per-trial plot (placeholder until written).

@@ -1,0 +1,259 @@
+//! A synthetic treadmill gait with known events, for tests and benchmarks: markers in gaitfit's
+//! landmark names (x forward, y up) and one force plate per foot.
+//!
+//! Relative to the pelvis (fixed over the belt), each foot moves backward at the belt speed
+//! during stance and swings forward on a raised-cosine path; heel strike and toe off are the
+//! turning points of the heel and toe. The pelvis height follows a ballistic arc in every flight
+//! (running) and a cubic between flights, so the flight height of the running paper's eq. 3 is
+//! known exactly. The vertical force is a half sine over each stance.
+use super::{EventKind, EventSource, GaitEvent, Side};
+use crate::ingest::types::{Axis, ForcePlate, LabFrame, MarkerSet, Setting, SubjectInfo, Trial};
+use crate::units::G;
+
+/// The parameters of a synthetic gait.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SyntheticGait {
+    /// Belt speed, m/s.
+    pub belt_speed_m_per_s: f64,
+    /// Stride time, s.
+    pub stride_time_s: f64,
+    /// Stance time / stride time (above 0.5 walks, below runs).
+    pub duty_factor: f64,
+    /// Duration, s.
+    pub duration_s: f64,
+    /// Marker rate, Hz.
+    pub marker_rate_hz: f64,
+    /// Force rate, Hz.
+    pub force_rate_hz: f64,
+    /// First right heel strike, s.
+    pub first_hs_s: f64,
+    /// Pelvis height at toe off and heel strike, m.
+    pub pelvis_height_m: f64,
+}
+
+impl SyntheticGait {
+    /// A walk at 1.3 m/s, 1.1 s strides, 62 % stance.
+    pub fn walk() -> Self {
+        SyntheticGait {
+            belt_speed_m_per_s: 1.3,
+            stride_time_s: 1.1,
+            duty_factor: 0.62,
+            duration_s: 10.0,
+            marker_rate_hz: 150.0,
+            force_rate_hz: 1000.0,
+            first_hs_s: 0.3,
+            pelvis_height_m: 0.95,
+        }
+    }
+    /// A run at 3.5 m/s, 0.7 s strides, 36 % stance.
+    pub fn run() -> Self {
+        SyntheticGait {
+            belt_speed_m_per_s: 3.5,
+            stride_time_s: 0.7,
+            duty_factor: 0.36,
+            duration_s: 10.0,
+            marker_rate_hz: 150.0,
+            force_rate_hz: 1000.0,
+            first_hs_s: 0.3,
+            pelvis_height_m: 0.95,
+        }
+    }
+    /// Stance time, s.
+    pub fn stance_s(&self) -> f64 {
+        self.duty_factor * self.stride_time_s
+    }
+    /// Flight time of each step (running), s; negative values are double support.
+    pub fn flight_s(&self) -> f64 {
+        0.5 * self.stride_time_s - self.stance_s()
+    }
+    /// Step length, m.
+    pub fn step_length_m(&self) -> f64 {
+        0.5 * self.stride_time_s * self.belt_speed_m_per_s
+    }
+
+    fn hs_time(&self, side: Side, k: i64) -> f64 {
+        let off = if side == Side::Right { 0.0 } else { 0.5 };
+        self.first_hs_s + (k as f64 + off) * self.stride_time_s
+    }
+
+    /// The true events (heel strike, toe off) within the trial.
+    pub fn events(&self) -> Vec<GaitEvent> {
+        let mut out = Vec::new();
+        let n = (self.duration_s / self.stride_time_s).ceil() as i64 + 2;
+        for side in [Side::Left, Side::Right] {
+            for k in -2..n {
+                let hs = self.hs_time(side, k);
+                for (t, kind) in [
+                    (hs, EventKind::HeelStrike),
+                    (hs + self.stance_s(), EventKind::ToeOff),
+                ] {
+                    if t > 0.0 && t < self.duration_s {
+                        out.push(GaitEvent {
+                            time_s: t,
+                            side,
+                            kind,
+                            source: EventSource::Generated,
+                        });
+                    }
+                }
+            }
+        }
+        out.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        out
+    }
+
+    /// `(phase in the stride from this foot's heel strike, s)`.
+    fn phase(&self, side: Side, t: f64) -> f64 {
+        let t0 = self.hs_time(side, 0);
+        (t - t0).rem_euclid(self.stride_time_s)
+    }
+
+    /// Heel position (forward relative to the pelvis, height) at `t`.
+    fn heel(&self, side: Side, t: f64) -> (f64, f64) {
+        let v = self.belt_speed_m_per_s;
+        let ts = self.stance_s();
+        let x_hs = 0.5 * v * ts;
+        let x_to = -0.5 * v * ts;
+        let p = self.phase(side, t);
+        if p < ts {
+            // Stance: heel on the belt; it rises in the last 30 % (heel off) for realism.
+            let h = if p > 0.7 * ts {
+                0.06 * ((p - 0.7 * ts) / (0.3 * ts)).powi(2)
+            } else {
+                0.0
+            };
+            (x_hs - v * p, 0.06 + h)
+        } else {
+            let s = (p - ts) / (self.stride_time_s - ts);
+            let x = x_to + (x_hs - x_to) * 0.5 * (1.0 - (std::f64::consts::PI * s).cos());
+            let h = 0.06 + 0.06 * (1.0 - s) + 0.08 * (std::f64::consts::PI * s).sin();
+            (x, h)
+        }
+    }
+
+    /// Pelvis height at `t`: a ballistic arc in each flight (running), a cubic in between.
+    fn pelvis_height(&self, t: f64) -> f64 {
+        let y0 = self.pelvis_height_m;
+        let step = 0.5 * self.stride_time_s;
+        let tf = self.flight_s();
+        let p = (t - self.first_hs_s).rem_euclid(step); // from a heel strike
+        if tf <= 0.0 {
+            return y0 + 0.02 * (2.0 * std::f64::consts::PI * p / step).cos();
+        }
+        let ts = step - tf; // stance part of the step
+        let vy = G * tf / 2.0;
+        if p >= ts {
+            let tau = p - ts;
+            y0 + vy * tau - 0.5 * G * tau * tau
+        } else {
+            // Cubic Hermite from (y0, −vy) at landing to (y0, +vy) at take-off.
+            let s = p / ts;
+            let (h10, h11) = (s * s * s - 2.0 * s * s + s, s * s * s - s * s);
+            y0 + h10 * ts * (-vy) + h11 * ts * vy
+        }
+    }
+
+    /// The trial: markers (`pelvis`, `{l,r}_{heel,ball,toe,ankle,knee,hip}`) and one plate per
+    /// foot.
+    pub fn trial(&self) -> Trial {
+        let nm = (self.duration_s * self.marker_rate_hz) as usize;
+        let time_s: Vec<f64> = (0..nm).map(|i| i as f64 / self.marker_rate_hz).collect();
+        let mut names = vec!["pelvis".to_string()];
+        let mut positions = vec![time_s
+            .iter()
+            .map(|&t| [0.0, self.pelvis_height(t), 0.0])
+            .collect::<Vec<_>>()];
+        for side in [Side::Left, Side::Right] {
+            let z = if side == Side::Left { -0.1 } else { 0.1 };
+            let p = side.prefix();
+            let heel: Vec<(f64, f64)> = time_s.iter().map(|&t| self.heel(side, t)).collect();
+            let mk = |dx: f64, dy: f64| -> Vec<[f64; 3]> {
+                heel.iter().map(|&(x, y)| [x + dx, y + dy, z]).collect()
+            };
+            names.push(format!("{p}_heel"));
+            positions.push(mk(0.0, 0.0));
+            names.push(format!("{p}_ball"));
+            positions.push(mk(0.16, -0.03));
+            names.push(format!("{p}_toe"));
+            positions.push(mk(0.21, -0.035));
+            names.push(format!("{p}_ankle"));
+            positions.push(mk(0.05, 0.03));
+            names.push(format!("{p}_knee"));
+            positions.push(mk(0.06, 0.45));
+            names.push(format!("{p}_hip"));
+            positions.push(
+                time_s
+                    .iter()
+                    .map(|&t| [0.0, self.pelvis_height(t), z])
+                    .collect(),
+            );
+        }
+        let markers = MarkerSet {
+            rate_hz: self.marker_rate_hz,
+            time_s,
+            names,
+            positions,
+        };
+        let nf = (self.duration_s * self.force_rate_hz) as usize;
+        let ft: Vec<f64> = (0..nf).map(|i| i as f64 / self.force_rate_hz).collect();
+        let ts = self.stance_s();
+        let plates = [Side::Left, Side::Right]
+            .into_iter()
+            .map(|side| {
+                let force_n = ft
+                    .iter()
+                    .map(|&t| {
+                        let p = self.phase(side, t);
+                        let fy = if p < ts {
+                            750.0 * (std::f64::consts::PI * p / ts).sin()
+                        } else {
+                            0.0
+                        };
+                        [0.0, fy, 0.0]
+                    })
+                    .collect();
+                let cop_m = ft
+                    .iter()
+                    .map(|&t| {
+                        let p = self.phase(side, t);
+                        if p < ts {
+                            let (x, _) = self.heel(side, t);
+                            [x + 0.2 * p / ts, 0.0, 0.0]
+                        } else {
+                            [f64::NAN; 3]
+                        }
+                    })
+                    .collect();
+                ForcePlate {
+                    name: format!("{side} belt"),
+                    rate_hz: self.force_rate_hz,
+                    time_s: ft.clone(),
+                    force_n,
+                    cop_m,
+                    free_moment_nm: Vec::new(),
+                    side: Some(side),
+                }
+            })
+            .collect();
+        let mut trial = Trial::new("synthetic.trc", "synthetic");
+        trial.subject = SubjectInfo {
+            id: Some("synthetic".into()),
+            body_height_m: Some(1.8),
+            leg_length_m: Some(0.95),
+            mass_kg: Some(70.0),
+            notes: Vec::new(),
+        };
+        trial.setting = Setting::Treadmill {
+            belt_speed_m_per_s: self.belt_speed_m_per_s,
+        };
+        trial.frame = Some(LabFrame {
+            vertical: Axis::Y,
+            forward: Axis::X,
+            forward_sign: 1.0,
+            how: "synthetic".into(),
+        });
+        trial.markers = Some(markers);
+        trial.plates = plates;
+        trial
+    }
+}
