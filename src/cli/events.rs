@@ -1,11 +1,315 @@
-//! `gaitfit events`.
+//! `gaitfit events`: detect gait events in measured files and write per-step tables.
+use crate::events::compare::CompareTable;
+use crate::events::input::{expand_inputs, read_input, TrialInput};
+use crate::events::{
+    analyse, steps_from_analysis, EventOptions, EventSource, Gait, MarkerMap, PrimarySource,
+    StepTable,
+};
+use crate::ingest::ReadOptions;
+use anyhow::Context;
 use std::process::ExitCode;
 
 /// Arguments of `gaitfit events`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(
+    after_help = "Inputs: .trc (with X.forces or X_grf.mot beside it), .mot/.sto GRF, \
+    .forces, .c3d, WBDS *grf.txt, Winter's table; folders are searched recursively (static \
+    trials and companion files skipped); MARKERS+FORCES pairs a marker file with a force file \
+    of another name (e.g. motion_capture_run.trc+grf_run.mot).\n\nDefaults: force 20 Hz \
+    low-pass, contact on above 50 N and off below 20 N (events timed at 20 N); markers 6 Hz \
+    low-pass; Zeni extrema hysteresis 30 % of the signal range; matching tolerance 60 ms."
+)]
+pub struct Args {
+    /// Trial files or folders.
+    #[arg(required = true, value_name = "INPUT")]
+    pub inputs: Vec<std::path::PathBuf>,
+    /// Write the per-step table here (CSV); without it the table goes to standard output
+    /// unless --compare or --summary is given.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<std::path::PathBuf>,
+    /// Compare the kinematic methods with the force-plate events (`force`) or with the
+    /// file's reference events (`reference`): detection F1 and timing error per event type.
+    #[arg(long, value_name = "force|reference")]
+    pub compare: Option<String>,
+    /// Write one check plot (SVG) per trial into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plots: Option<std::path::PathBuf>,
+    /// Print a per-trial summary (steps, cadence, step length, stance, double support/flight).
+    #[arg(long)]
+    pub summary: bool,
+    /// Which events build the steps: auto (force with per-foot plates, else Zeni), force,
+    /// zeni, zeni-velocity, reference.
+    #[arg(long, default_value = "auto", value_name = "SOURCE")]
+    pub events: String,
+    /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
+    #[arg(long, default_value = "auto", value_name = "PRESET")]
+    pub markers: String,
+    /// Override one marker role, e.g. --marker r_heel=RHEE or --marker pelvis=RASI+LASI
+    /// (repeatable; roles: pelvis, {l,r}_{heel,toe,meta,ankle,knee,hip}).
+    #[arg(long = "marker", value_name = "ROLE=NAME")]
+    pub marker: Vec<String>,
+    /// Walk or run (default: from the file, else from the events).
+    #[arg(long, value_name = "walk|run")]
+    pub gait: Option<String>,
+    /// Treadmill belt speed, m/s (default: from the file or its metadata).
+    #[arg(long, value_name = "M_PER_S")]
+    pub belt_speed: Option<f64>,
+    /// Force low-pass cutoff, Hz.
+    #[arg(long, default_value_t = 20.0)]
+    pub force_cutoff: f64,
+    /// Contact-on threshold, N.
+    #[arg(long, default_value_t = 50.0)]
+    pub on: f64,
+    /// Contact-off threshold, N.
+    #[arg(long, default_value_t = 20.0)]
+    pub off: f64,
+    /// Subtract a linear baseline from drifting force plates instead of failing.
+    #[arg(long)]
+    pub correct_drift: bool,
+    /// Marker low-pass cutoff, Hz.
+    #[arg(long, default_value_t = 6.0)]
+    pub marker_cutoff: f64,
+    /// Matching tolerance for --compare, ms.
+    #[arg(long, default_value_t = 60.0)]
+    pub tolerance_ms: f64,
+}
+
+fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
+    let mut read = ReadOptions::default();
+    let mut opts = EventOptions::default();
+    if let Some(g) = &args.gait {
+        let g = Gait::parse(g).with_context(|| format!("--gait {g}: use walk or run"))?;
+        opts.gait = Some(g);
+        read.gait = Some(g);
+    }
+    read.belt_speed_m_per_s = args.belt_speed;
+    opts.primary = PrimarySource::parse(&args.events).with_context(|| {
+        format!(
+            "--events {}: use auto, force, zeni, zeni-velocity or reference",
+            args.events
+        )
+    })?;
+    if args.markers != "auto" || !args.marker.is_empty() {
+        let mut m = if args.markers == "auto" {
+            MarkerMap::default()
+        } else {
+            MarkerMap::preset(&args.markers).with_context(|| {
+                format!(
+                    "--markers {}: use auto or one of {}",
+                    args.markers,
+                    crate::events::markers::PRESETS.join(", ")
+                )
+            })?
+        };
+        for a in &args.marker {
+            m.set(a)?;
+        }
+        opts.markers = Some(m);
+    }
+    opts.force.cutoff_hz = args.force_cutoff;
+    opts.force.on_n = args.on;
+    opts.force.off_n = args.off;
+    opts.force.correct_drift = args.correct_drift;
+    opts.kinematic.cutoff_hz = args.marker_cutoff;
+    Ok((read, opts))
+}
+
+struct TrialResult {
+    table: StepTable,
+    compare: CompareTable,
+    notes: Vec<String>,
+    label: String,
+}
+
+fn process(
+    input: &TrialInput,
+    read: &ReadOptions,
+    opts: &EventOptions,
+    args: &Args,
+    compare_with: Option<EventSource>,
+) -> anyhow::Result<TrialResult> {
+    let trial = read_input(input, read)?;
+    let an = analyse(&trial, opts)?;
+    let table = steps_from_analysis(&trial, &an, opts)?;
+    let compare = match compare_with {
+        Some(src) => an.compare(src, args.tolerance_ms / 1000.0),
+        None => CompareTable::default(),
+    };
+    if let Some(dir) = &args.plots {
+        let stem = input
+            .path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "trial".into());
+        let parent = input
+            .path
+            .parent()
+            .and_then(|p| p.file_name())
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let name = if parent.is_empty() {
+            format!("{stem}.svg")
+        } else {
+            format!("{parent}_{stem}.svg")
+        };
+        crate::events::plot::write_svg(&dir.join(name), &an)?;
+    }
+    let mut notes = trial.notes.clone();
+    notes.extend(an.events.notes.iter().cloned());
+    notes.extend(table.notes.iter().cloned());
+    Ok(TrialResult {
+        table,
+        compare,
+        notes,
+        label: input.label(),
+    })
+}
+
+fn mean_sd(v: &[f64]) -> String {
+    if v.is_empty() {
+        return "–".into();
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let sd = if v.len() > 1 {
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    format!("{m:.3}±{sd:.3}")
+}
+
+fn summary(results: &[TrialResult]) -> String {
+    let mut s = format!(
+        "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
+        "trial",
+        "gait",
+        "steps",
+        "speed m/s",
+        "cadence /min",
+        "step len m",
+        "stance s",
+        "dbl supp s",
+        "flight s"
+    );
+    for r in results {
+        let rows = &r.table.rows;
+        let col = |f: &dyn Fn(&crate::ingest::trials::StepRow) -> Option<f64>| -> Vec<f64> {
+            rows.iter().filter_map(f).collect()
+        };
+        let label: String = r
+            .label
+            .chars()
+            .rev()
+            .take(44)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        s.push_str(&format!(
+            "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
+            label,
+            rows.first()
+                .and_then(|x| x.gait)
+                .map(|g| g.to_string())
+                .unwrap_or_default(),
+            rows.len(),
+            mean_sd(&col(&|x| x.speed_m_per_s)),
+            mean_sd(&col(&|x| x.step_freq_hz.map(|f| f * 60.0))),
+            mean_sd(&col(&|x| x.step_length_m)),
+            mean_sd(&col(&|x| x.stance_time_s)),
+            mean_sd(&col(&|x| x.double_support_time_s)),
+            mean_sd(&col(&|x| x.flight_time_s)),
+        ));
+    }
+    s
+}
 
 /// Runs `gaitfit events`.
-pub fn run(_args: &Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("gaitfit events: not implemented yet")
+pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
+    use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    use rayon::prelude::*;
+    use std::io::IsTerminal;
+    let (read, opts) = options(args)?;
+    let compare_with = match args.compare.as_deref() {
+        None => None,
+        Some("force") => Some(EventSource::Force),
+        Some("reference") => Some(EventSource::Reference),
+        Some(other) => anyhow::bail!("--compare {other}: use force or reference"),
+    };
+    let inputs = expand_inputs(&args.inputs)?;
+    let bar = ProgressBar::new(inputs.len() as u64);
+    if std::io::stderr().is_terminal() {
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} trials {msg}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+    } else {
+        bar.set_draw_target(ProgressDrawTarget::hidden());
+    }
+    let results: Vec<anyhow::Result<TrialResult>> = inputs
+        .par_iter()
+        .map(|i| {
+            let r = process(i, &read, &opts, args, compare_with)
+                .with_context(|| format!("while processing {}", i.label()));
+            bar.inc(1);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    // No partial output: any failed trial fails the command before anything is written.
+    let mut ok = Vec::new();
+    let mut errors = Vec::new();
+    for r in results {
+        match r {
+            Ok(t) => ok.push(t),
+            Err(e) => errors.push(format!("{e:#}")),
+        }
+    }
+    if !errors.is_empty() {
+        anyhow::bail!(
+            "{} of {} trial(s) failed; nothing was written:\n  {}",
+            errors.len(),
+            inputs.len(),
+            errors.join("\n  ")
+        );
+    }
+    let tables: Vec<StepTable> = ok.iter().map(|r| r.table.clone()).collect();
+    let n_rows: usize = tables.iter().map(|t| t.rows.len()).sum();
+    match &args.output {
+        Some(path) => {
+            crate::events::steps::write_csv(path, &tables)?;
+            eprintln!(
+                "gaitfit events: {n_rows} steps from {} trial(s) → {}",
+                ok.len(),
+                path.display()
+            );
+        }
+        None if compare_with.is_none() && !args.summary => {
+            let stdout = std::io::stdout();
+            let mut lock = stdout.lock();
+            crate::events::steps::write_csv_to(&mut lock, &tables)?;
+        }
+        None => {}
+    }
+    if args.summary {
+        print!("{}", summary(&ok));
+        for r in &ok {
+            for n in &r.notes {
+                eprintln!("{}: {n}", r.label);
+            }
+        }
+    }
+    if compare_with.is_some() {
+        let mut all = CompareTable::default();
+        for r in &ok {
+            all.merge(&r.compare);
+        }
+        if all.rows.is_empty() {
+            println!("no trial had both kinematic events and the requested reference events");
+        } else {
+            print!("{}", all.render());
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }

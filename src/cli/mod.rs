@@ -31,7 +31,7 @@ pub enum Command {
     /// Export fitted coefficient tables for other programs (Rust, JSON, TOML, CSV).
     Export(export::Args),
     /// Detect gait events in measured files and write per-step tables.
-    Events(events::Args),
+    Events(Box<events::Args>),
     /// Generate motion (running, walking, or a generalized measured walk).
     Generate(generate::Args),
 }

@@ -426,6 +426,7 @@ pub fn detect(
         && [Side::Left, Side::Right]
             .iter()
             .all(|s| trial.plates.iter().any(|p| p.side == Some(*s)));
+    resolve_cross_belt(&mut res.contacts, &mut res.notes);
     if !unassigned.is_empty() {
         assign_feet(&mut unassigned, kin, &mut res.notes);
         res.contacts.extend(unassigned);
@@ -496,6 +497,54 @@ fn assign_feet(contacts: &mut [Contact], kin: Option<&Kinematics>, notes: &mut V
     );
 }
 
+/// On per-foot plates (treadmill belts), a foot that lands across both belts shows as two
+/// simultaneous contacts, one on each belt. Contacts of different belts that overlap by more
+/// than half of the shorter one cannot be two feet (running has no overlap, walking's double
+/// support is a fifth of a stance or less): they are one foot, the one that alternates with the
+/// previous contact, and are merged.
+fn resolve_cross_belt(contacts: &mut [Contact], notes: &mut Vec<String>) {
+    contacts.sort_by(|a, b| a.span_s.0.total_cmp(&b.span_s.0));
+    let n = contacts.len();
+    let mut last_clean: Option<Side> = None;
+    let mut i = 0;
+    while i < n {
+        let overlapping = if i + 1 < n {
+            let (a, b) = (&contacts[i], &contacts[i + 1]);
+            let overlap = (a.span_s.1.min(b.span_s.1) - b.span_s.0.max(a.span_s.0)).max(0.0);
+            let shorter = (a.span_s.1 - a.span_s.0).min(b.span_s.1 - b.span_s.0);
+            a.side != b.side && overlap > 0.5 * shorter
+        } else {
+            false
+        };
+        if overlapping {
+            let side = match last_clean {
+                Some(s) => s.opposite(),
+                None => contacts
+                    .get(i + 2)
+                    .map(|c| c.side.opposite())
+                    .unwrap_or(contacts[i].side),
+            };
+            notes.push(format!(
+                "one foot on both belts at {:.3}–{:.3} s ({} and {}): merged into one {side} \
+                 contact (the foot that alternates with the previous contact)",
+                contacts[i].span_s.0.min(contacts[i + 1].span_s.0),
+                contacts[i].span_s.1.max(contacts[i + 1].span_s.1),
+                contacts[i].plates.join("+"),
+                contacts[i + 1].plates.join("+"),
+            ));
+            for c in &mut contacts[i..i + 2] {
+                c.side = side;
+                c.assigned_by = "alternation (one foot on both belts)".into();
+            }
+            last_clean = Some(side);
+            i += 2;
+        } else {
+            last_clean = Some(contacts[i].side);
+            i += 1;
+        }
+    }
+}
+
 /// Merges contacts of the same foot that overlap in time (one foot on two plates).
 fn merge_same_foot(mut contacts: Vec<Contact>) -> Vec<Contact> {
     contacts.sort_by(|a, b| {
@@ -517,6 +566,10 @@ fn merge_same_foot(mut contacts: Vec<Contact>) -> Vec<Contact> {
                 }
                 last.span_s = (last.span_s.0.min(c.span_s.0), last.span_s.1.max(c.span_s.1));
                 last.peak_n = last.peak_n.max(c.peak_n);
+                // The centre of pressure of one plate is not the foot's: drop it.
+                last.cop_m = None;
+                last.cop_time_mean_s = None;
+                last.cop_slope = None;
                 continue;
             }
         }
@@ -672,6 +725,27 @@ mod tests {
         assert_eq!(r.contacts.len(), 2, "{:?}", r.contacts);
         assert_ne!(r.contacts[0].side, r.contacts[1].side);
         assert_eq!(r.contacts[0].plates.len(), 2);
+    }
+
+    #[test]
+    fn a_foot_on_both_belts_is_one_contact() {
+        // Running: R 0.1–0.35, L 0.5–0.75, then the right foot lands across both belts
+        // (0.9–1.15 on both), then L 1.3–1.55.
+        let r = plate(Some(Side::Right), &[(0.1, 0.35), (0.9, 1.15)], 1000.0, 2.0);
+        let mut l = plate(
+            Some(Side::Left),
+            &[(0.5, 0.75), (0.92, 1.12), (1.3, 1.55)],
+            1000.0,
+            2.0,
+        );
+        l.name = "L".into();
+        let res = detect(&trial(vec![r, l]), None, &ForceOptions::default()).unwrap();
+        let sides: Vec<Side> = res.contacts.iter().map(|c| c.side).collect();
+        assert_eq!(
+            sides,
+            vec![Side::Right, Side::Left, Side::Right, Side::Left]
+        );
+        assert!(res.notes.iter().any(|n| n.contains("both belts")));
     }
 
     #[test]

@@ -16,6 +16,7 @@
 pub mod compare;
 pub mod filter;
 pub mod force;
+pub mod input;
 pub mod kinematic;
 pub mod markers;
 pub mod phases;
@@ -150,18 +151,21 @@ pub enum PrimarySource {
     ZeniCoordinate,
     /// Zeni velocity variant.
     ZeniVelocity,
+    /// Foot-marker heights seeded by the Zeni stances.
+    FootHeight,
     /// The events stored in the file (C3D EVENT group).
     Reference,
 }
 
 impl PrimarySource {
-    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|reference`.
+    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|foot-height|reference`.
     pub fn parse(s: &str) -> Option<Self> {
         match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
             "auto" => Some(Self::Auto),
             "force" => Some(Self::Force),
             "zeni" | "zeni-coordinate" | "coordinate" | "kinematic" => Some(Self::ZeniCoordinate),
             "zeni-velocity" | "velocity" => Some(Self::ZeniVelocity),
+            "foot" | "foot-height" => Some(Self::FootHeight),
             "reference" | "c3d" => Some(Self::Reference),
             _ => None,
         }
@@ -218,7 +222,11 @@ pub struct TrialEvents {
     pub zeni_coordinate: Vec<GaitEvent>,
     /// Zeni velocity-variant events.
     pub zeni_velocity: Vec<GaitEvent>,
-    /// Foot-marker phases (foot flat, heel off, meta off, toe off from the foot markers).
+    /// Initial contact and toe off from the foot-marker heights, seeded by the Zeni stances
+    /// (see [`phases::foot_contact_events`]).
+    pub foot_contact: Vec<GaitEvent>,
+    /// Foot-marker phases of the primary stances (foot flat, heel off, meta off, and toe off
+    /// from a distinct toe marker).
     pub phases: Vec<GaitEvent>,
     /// Events read from the file (kept, never overwritten).
     pub reference: Vec<GaitEvent>,
@@ -235,7 +243,7 @@ impl TrialEvents {
             EventSource::Force => &self.force,
             EventSource::ZeniCoordinate => &self.zeni_coordinate,
             EventSource::ZeniVelocity => &self.zeni_velocity,
-            EventSource::FootMarkers => &self.phases,
+            EventSource::FootMarkers => &self.foot_contact,
             EventSource::Reference => &self.reference,
             EventSource::Generated => &[],
         }
@@ -270,12 +278,13 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
     }
     let fr = force::detect(trial, kin.as_ref(), &opts.force)?;
     notes.extend(fr.notes.iter().cloned());
-    let (zc, zv) = match &kin {
-        Some(k) => (
-            k.zeni_coordinate(&opts.kinematic),
-            k.zeni_velocity(&opts.kinematic),
-        ),
-        None => (Vec::new(), Vec::new()),
+    let (zc, zv, fc) = match &kin {
+        Some(k) => {
+            let zc = k.zeni_coordinate(&opts.kinematic);
+            let fc = phases::foot_contact_events(k, &zc, &opts.phases);
+            (zc, k.zeni_velocity(&opts.kinematic), fc)
+        }
+        None => (Vec::new(), Vec::new(), Vec::new()),
     };
     let mut ev = TrialEvents {
         path: path.clone(),
@@ -285,6 +294,7 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         force_complete: fr.complete,
         zeni_coordinate: zc,
         zeni_velocity: zv,
+        foot_contact: fc,
         phases: Vec::new(),
         reference: trial.reference_events.clone(),
         primary: EventSource::Force,
@@ -339,6 +349,7 @@ fn choose_primary(
             need(EventSource::ZeniCoordinate, "the Zeni coordinate method")
         }
         PrimarySource::ZeniVelocity => need(EventSource::ZeniVelocity, "the Zeni velocity method"),
+        PrimarySource::FootHeight => need(EventSource::FootMarkers, "the foot-marker heights"),
         PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
         PrimarySource::Auto => {
             if ev.force_complete && has_both_kinds(&ev.force) {
@@ -365,4 +376,55 @@ fn choose_primary(
 pub fn steps_from_trial(trial: &Trial, opts: &EventOptions) -> Result<StepTable, EventError> {
     let an = analyse(trial, opts)?;
     steps_from_analysis(trial, &an, opts)
+}
+
+impl Analysis {
+    /// Compares the kinematic methods (Zeni coordinate and velocity) with the force-plate
+    /// events (`reference = Force`) or with the file's reference events (`Reference`), over the
+    /// time both cover. Returns an empty table when either side has no events.
+    pub fn compare(&self, reference: EventSource, tol_s: f64) -> compare::CompareTable {
+        let mut table = compare::CompareTable::default();
+        let refs = self.events.of(reference);
+        let Some(k) = &self.kinematics else {
+            return table;
+        };
+        if refs.is_empty() || k.time_s.is_empty() {
+            return table;
+        }
+        let (coverage, mut span) = match reference {
+            EventSource::Force => (
+                if self.events.force_complete {
+                    compare::Coverage::Complete
+                } else {
+                    compare::Coverage::MatchedOnly
+                },
+                self.force
+                    .vertical
+                    .iter()
+                    .filter(|v| !v.time_s.is_empty())
+                    .fold((f64::NEG_INFINITY, f64::INFINITY), |(a, b), v| {
+                        (a.max(v.time_s[0]), b.min(v.time_s[v.time_s.len() - 1]))
+                    }),
+            ),
+            _ => (
+                compare::Coverage::Window,
+                (f64::NEG_INFINITY, f64::INFINITY),
+            ),
+        };
+        span.0 = span.0.max(k.time_s[0]);
+        span.1 = span.1.min(k.time_s[k.time_s.len() - 1]);
+        let rname = match reference {
+            EventSource::Force => "force",
+            _ => "reference",
+        };
+        for (name, det) in [
+            ("zeni_coordinate", &self.events.zeni_coordinate),
+            ("zeni_velocity", &self.events.zeni_velocity),
+            ("foot_height", &self.events.foot_contact),
+        ] {
+            let res = compare::compare(det, refs, coverage, span, tol_s);
+            table.add(name, rname, &res);
+        }
+        table
+    }
 }

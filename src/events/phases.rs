@@ -153,6 +153,73 @@ pub fn detect(k: &Kinematics, primary: &[GaitEvent], opts: &PhaseOptions) -> Vec
     out
 }
 
+/// Initial contact and toe off from the foot-marker heights, seeded by kinematic stances (the
+/// Zeni events): for each seed stance, every foot marker's flat level is its lowest height
+/// during the stance; initial contact is the first time, from 0.15 s before the seed heel
+/// strike, that the heel or the metatarsal/toe marker (whichever lands first: heel strikers
+/// and forefoot strikers alike) comes down to its flat level + `height_tol_m`; toe off is the
+/// last time before 0.15 s after the seed toe off that the toe (else metatarsal) marker rises
+/// through its flat level + tolerance. Unlike the pelvis-relative extrema of Zeni et al., this
+/// looks at the foot touching the floor itself, which is what a force plate sees.
+pub fn foot_contact_events(
+    k: &Kinematics,
+    seeds: &[GaitEvent],
+    opts: &PhaseOptions,
+) -> Vec<GaitEvent> {
+    let mut out = Vec::new();
+    let n = k.time_s.len();
+    if n < 3 {
+        return out;
+    }
+    let tol = opts.height_tol_m;
+    for (side, hs, to) in stances(seeds) {
+        let l = k.leg(side);
+        let (a, b) = frames(k, hs, to);
+        if b <= a + 2 {
+            continue;
+        }
+        let a0 = k.frame_at(hs - 0.15);
+        let b2 = k.frame_at(to + 0.15).min(n - 1);
+        let flat = |h: &[f64]| h[a..=b].iter().copied().fold(f64::INFINITY, f64::min);
+        let mut contact: Option<f64> = None;
+        let front = l.meta.as_ref().or(l.toe.as_ref());
+        for m in [l.heel.as_ref(), front].into_iter().flatten() {
+            let h = heights(k, m);
+            let lv = flat(&h) + tol;
+            // Only a real descent counts: the marker must be above the level at the window start.
+            if h[a0] > lv {
+                if let Some(t) = first_down(k, &h, a0, b, lv) {
+                    contact = Some(contact.map_or(t, |c: f64| c.min(t)));
+                }
+            }
+        }
+        if let Some(t) = contact {
+            out.push(GaitEvent {
+                time_s: t,
+                side,
+                kind: EventKind::HeelStrike,
+                source: EventSource::FootMarkers,
+            });
+        }
+        if let Some(m) = l.toe.as_ref().or(l.meta.as_ref()) {
+            let h = heights(k, m);
+            let lv = flat(&h) + tol;
+            if h[b2] > lv {
+                if let Some(t) = last_up(k, &h, a, b2, lv) {
+                    out.push(GaitEvent {
+                        time_s: t,
+                        side,
+                        kind: EventKind::ToeOff,
+                        source: EventSource::FootMarkers,
+                    });
+                }
+            }
+        }
+    }
+    out.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
+    out
+}
+
 /// Sagittal 2-D coordinates `(forward, up)` of a point.
 fn sag(k: &Kinematics, p: &[f64; 3]) -> (f64, f64) {
     (k.fwd(p), k.up(p))

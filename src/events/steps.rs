@@ -6,9 +6,8 @@
 //! - step time `t_B − t_A`, step frequency `1/(t_B − t_A)`; stance of A (its heel strike to its
 //!   toe off), swing of A (its toe off to its next heel strike);
 //! - walking (B lands before A lifts): double support `t_ds` = B's toe off after A's heel strike
-//!   − `t_A` (walking paper §3, one double support state per step), and `t_ds / t_cycle · 100`
-//!   with `t_cycle` A's stride time (A's heel strike to its next), or twice the step time when
-//!   the stride is not complete;
+//!   − `t_A` (walking paper §3: a step is the double support state followed by the single
+//!   support state), and `t_ds / t_cycle · 100` with `t_cycle = 2 / sf` as in §3;
 //! - running (A lifts before B lands): flight time `t_B − toe off of A`, and the flight height
 //!   H of the running paper's eq. 3 from the pelvis height at A's toe off (`y1`) and B's heel
 //!   strike (`y2`): `H = (t_flight − 2(y1 − y2)/(g·t_flight))² · g/8`. H is the apex of the
@@ -153,7 +152,7 @@ pub fn steps_from_analysis(
         EventSource::ZeniCoordinate => "zeni_coordinate",
         EventSource::ZeniVelocity => "zeni_velocity",
         EventSource::Reference => "reference",
-        EventSource::FootMarkers => "foot_markers",
+        EventSource::FootMarkers => "foot_height",
         EventSource::Generated => "generated",
     };
     let setting = opts.setting.unwrap_or(match (trial.setting, kin) {
@@ -337,8 +336,8 @@ pub fn steps_from_analysis(
             } else if let Some(t2) = to_b {
                 gait = Some(Gait::Walk);
                 row.double_support_time_s = Some(t2 - ta);
-                let cycle = stride_t.unwrap_or(2.0 * step_t);
-                row.double_support_pct_cycle = Some((t2 - ta) / cycle * 100.0);
+                // t_cycle = 2 / sf, the walking paper's §3 (and the trials schema's) definition.
+                row.double_support_pct_cycle = Some((t2 - ta) / (2.0 * step_t) * 100.0);
             }
             // Step length.
             let (sl, method) = match (heel_at(a.side, ta), heel_at(b.side, tb)) {
