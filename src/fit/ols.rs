@@ -362,53 +362,53 @@ fn validate(p: &LinearProblem) -> Result<(), FitError> {
             need: k + 1,
         });
     }
-    for (i, &yi) in p.y.iter().enumerate() {
-        if !yi.is_finite() {
-            return Err(FitError::NonFinite {
-                relation: name,
-                what: "y".into(),
-                row: i,
-                value: yi,
-            });
-        }
+    if let Some(i) = p.y.as_slice().iter().position(|v| !v.is_finite()) {
+        return Err(FitError::NonFinite {
+            relation: name,
+            what: "y".into(),
+            row: i,
+            value: p.y[i],
+        });
     }
-    for j in 0..k {
-        for (i, &v) in p.x.column(j).iter().enumerate() {
-            if !v.is_finite() {
-                return Err(FitError::NonFinite {
-                    relation: name,
-                    what: format!("column {}", col_name(p, j)),
-                    row: i,
-                    value: v,
-                });
-            }
-        }
+    // Column-major storage: one linear scan finds the first bad cell.
+    if let Some(idx) = p.x.as_slice().iter().position(|v| !v.is_finite()) {
+        let (i, j) = (idx % n, idx / n);
+        return Err(FitError::NonFinite {
+            relation: name,
+            what: format!("column {}", col_name(p, j)),
+            row: i,
+            value: p.x[(i, j)],
+        });
     }
     Ok(())
 }
 
-/// Fits `y ≈ Xβ` by (weighted) least squares; see the [module docs](self) for the method.
-///
-/// Errors: [`FitError::TooFew`] when `n ≤ p`, [`FitError::NonFinite`] for NaN/∞ inputs,
-/// [`FitError::InvalidInput`] for mismatched lengths or non-positive weights,
-/// [`FitError::Singular`] for a rank-deficient design (naming the collinear columns).
-///
-/// ```
-/// use nalgebra::{DMatrix, DVector};
-/// use gaitfit::fit::ols::{ols, LinearProblem};
-/// let x = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 1.0, 1.0, 1.0, 2.0, 1.0, 3.0]);
-/// let y = DVector::from_vec(vec![1.0, 3.1, 4.9, 7.0]);
-/// let fit = ols(&LinearProblem::new(&x, &y)).unwrap();
-/// assert!((fit.coef[1] - 1.98).abs() < 1e-12); // Sxy/Sxx = 9.9/5
-/// assert_eq!(fit.df_resid, 2);
-/// ```
-pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
+/// The factorised problem: everything [`ols`] and [`ols_coef_rss`] share.
+struct Core {
+    wv: Vec<f64>,
+    means: Vec<f64>,
+    scales: Vec<f64>,
+    rinv: DMatrix<f64>,
+    t: DMatrix<f64>,
+    coef: DVector<f64>,
+    centred: Vec<f64>,
+    cond: f64,
+    rss_qr: f64,
+}
+
+fn solve_core(p: &LinearProblem) -> Result<Core, FitError> {
     validate(p)?;
     let (n, k) = (p.x.nrows(), p.x.ncols());
     let x = p.x;
-    let w = |i: usize| p.weights.map_or(1.0, |w| w[i]);
-    let sw: Vec<f64> = (0..n).map(|i| w(i).sqrt()).collect();
-    let sum_w: f64 = (0..n).map(w).sum();
+    // Column j of the column-major design as a contiguous slice.
+    let col = |j: usize| &x.as_slice()[j * n..(j + 1) * n];
+    let y = p.y.as_slice();
+    let wv: Vec<f64> = match p.weights {
+        Some(w) => w.as_slice().to_vec(),
+        None => vec![1.0; n],
+    };
+    let sw: Option<Vec<f64>> = p.weights.map(|_| wv.iter().map(|w| w.sqrt()).collect());
+    let sum_w: f64 = wv.iter().sum();
 
     // Centre non-intercept columns when the model has an intercept column.
     let ic = if p.has_intercept {
@@ -422,20 +422,21 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
             if j == ic {
                 continue;
             }
-            let col = x.column(j);
-            let m1 = (0..n).map(|i| w(i) * col[i]).sum::<f64>() / sum_w;
+            let c = col(j);
+            let m1 = c.iter().zip(&wv).map(|(v, w)| w * v).sum::<f64>() / sum_w;
             // Second pass corrects the rounding of the first (two-pass mean).
-            let corr = (0..n).map(|i| w(i) * (col[i] - m1)).sum::<f64>() / sum_w;
+            let corr = c.iter().zip(&wv).map(|(v, w)| w * (v - m1)).sum::<f64>() / sum_w;
             *m = m1 + corr;
         }
     }
     // Column scales (weighted 2-norms of the centred columns).
     let mut scales = vec![0.0; k];
     for (j, s) in scales.iter_mut().enumerate() {
-        let col = x.column(j);
         let m = means[j];
-        *s = (0..n)
-            .map(|i| w(i) * (col[i] - m).powi(2))
+        *s = col(j)
+            .iter()
+            .zip(&wv)
+            .map(|(v, w)| w * (v - m) * (v - m))
             .sum::<f64>()
             .sqrt();
         if *s == 0.0 || !s.is_finite() {
@@ -451,24 +452,35 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
         }
     }
 
-    // Streaming Householder QR of the scaled [A | b].
+    // Streaming Householder QR of the scaled [A | b], block by block: QR([R; block]).
     let kk = k + 1;
     let mut r_aug = DMatrix::<f64>::zeros(kk, kk);
     let mut start = 0;
     while start < n {
         let end = (start + QR_BLOCK_ROWS).min(n);
         let rows = end - start;
-        let mut m = DMatrix::<f64>::zeros(kk + rows, kk);
+        let h = kk + rows;
+        let mut m = DMatrix::<f64>::zeros(h, kk);
         m.view_mut((0, 0), (kk, kk)).copy_from(&r_aug);
+        let ms = m.as_mut_slice();
         for j in 0..k {
-            let col = x.column(j);
-            let (mj, sj) = (means[j], scales[j]);
-            for (r, i) in (start..end).enumerate() {
-                m[(kk + r, j)] = sw[i] * (col[i] - mj) / sj;
+            let (mj, inv_s) = (means[j], 1.0 / scales[j]);
+            let dst = &mut ms[j * h + kk..(j + 1) * h];
+            for (d, v) in dst.iter_mut().zip(&col(j)[start..end]) {
+                *d = (v - mj) * inv_s;
+            }
+            if let Some(sw) = &sw {
+                dst.iter_mut()
+                    .zip(&sw[start..end])
+                    .for_each(|(d, s)| *d *= s);
             }
         }
-        for (r, i) in (start..end).enumerate() {
-            m[(kk + r, k)] = sw[i] * p.y[i];
+        let dst = &mut ms[k * h + kk..(k + 1) * h];
+        dst.copy_from_slice(&y[start..end]);
+        if let Some(sw) = &sw {
+            dst.iter_mut()
+                .zip(&sw[start..end])
+                .for_each(|(d, s)| *d *= s);
         }
         let r = m.qr().r();
         r_aug.copy_from(&r.view((0, 0), (kk, kk)));
@@ -476,6 +488,7 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
     }
     let r = r_aug.view((0, 0), (k, k)).into_owned();
     let z = r_aug.view((0, k), (k, 1)).column(0).into_owned();
+    let rss_qr = r_aug[(k, k)] * r_aug[(k, k)];
 
     // Rank and condition number from the SVD of R (same singular values as A).
     let svd =
@@ -491,9 +504,8 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
     let cond = smax / smin;
     if !(smin > SINGULAR_RCOND * smax) {
         // Columns with a large share of the null-space direction are the collinear ones.
-        let v_t = svd.v_t.as_ref();
         let jmin = sv.imin();
-        let names: Vec<String> = match v_t {
+        let names: Vec<String> = match svd.v_t.as_ref() {
             Some(vt) => {
                 let row = vt.row(jmin);
                 let big = row.amax();
@@ -535,7 +547,7 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
             message: "zero pivot in the triangular factor".into(),
         })?;
 
-    // Centred-basis coefficients β'_j = c_j/s_j; raw intercept absorbs Σ m_j β'_j.
+    // Centred-basis coefficients β'_j = c_j/s_j; the raw intercept absorbs Σ m_j β'_j.
     let centred: Vec<f64> = (0..k).map(|j| c[j] / scales[j]).collect();
     let mut t = DMatrix::<f64>::zeros(k, k);
     for j in 0..k {
@@ -556,33 +568,91 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
         }
     }
 
-    // Fitted values, residuals, leverages in one pass over the rows.
-    let mut fitted = DVector::<f64>::zeros(n);
-    let mut residuals = DVector::<f64>::zeros(n);
-    let mut leverage = DVector::<f64>::zeros(n);
-    let mut a = vec![0.0; k];
-    let mut rss = 0.0;
-    for i in 0..n {
-        let mut yhat = 0.0;
-        for j in 0..k {
-            let d = x[(i, j)] - means[j];
-            yhat += d * centred[j];
-            a[j] = sw[i] * d / scales[j];
+    Ok(Core {
+        wv,
+        means,
+        scales,
+        rinv,
+        t,
+        coef,
+        centred,
+        cond,
+        rss_qr,
+    })
+}
+
+/// Coefficients and residual sum of squares only — one streaming QR pass, no residuals,
+/// leverages or covariance — for profiling a breakpoint or knot (many fits of the same size).
+/// The RSS comes from the QR's last diagonal element (`‖Qᵀb‖` tail), accurate to about
+/// `ε·Σwᵢyᵢ²`. Same validation and errors as [`ols`].
+pub fn ols_coef_rss(p: &LinearProblem) -> Result<(DVector<f64>, f64), FitError> {
+    let core = solve_core(p)?;
+    Ok((core.coef, core.rss_qr))
+}
+
+/// Fits `y ≈ Xβ` by (weighted) least squares; see the [module docs](self) for the method.
+///
+/// Errors: [`FitError::TooFew`] when `n ≤ p`, [`FitError::NonFinite`] for NaN/∞ inputs,
+/// [`FitError::InvalidInput`] for mismatched lengths or non-positive weights,
+/// [`FitError::Singular`] for a rank-deficient design (naming the collinear columns).
+///
+/// ```
+/// use nalgebra::{DMatrix, DVector};
+/// use gaitfit::fit::ols::{ols, LinearProblem};
+/// let x = DMatrix::from_row_slice(4, 2, &[1.0, 0.0, 1.0, 1.0, 1.0, 2.0, 1.0, 3.0]);
+/// let y = DVector::from_vec(vec![1.0, 3.1, 4.9, 7.0]);
+/// let fit = ols(&LinearProblem::new(&x, &y)).unwrap();
+/// assert!((fit.coef[1] - 1.98).abs() < 1e-12); // Sxy/Sxx = 9.9/5
+/// assert_eq!(fit.df_resid, 2);
+/// ```
+pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
+    let Core {
+        wv,
+        means,
+        scales,
+        rinv,
+        t,
+        coef,
+        centred,
+        cond,
+        rss_qr: _,
+    } = solve_core(p)?;
+    let (n, k) = (p.x.nrows(), p.x.ncols());
+    let x = p.x;
+    let col = |j: usize| &x.as_slice()[j * n..(j + 1) * n];
+    let y = p.y.as_slice();
+    // Fitted values (centred basis), residuals, and leverages h_ii = ‖R⁻ᵀ a_i‖², column by
+    // column so every pass is a contiguous, vectorisable loop.
+    let mut fitted = vec![0.0; n];
+    for j in 0..k {
+        let (mj, bj) = (means[j], centred[j]);
+        for (f, v) in fitted.iter_mut().zip(col(j)) {
+            *f += (v - mj) * bj;
         }
-        // h_ii = ‖R⁻ᵀ a_i‖²; column jj of R⁻¹ is nonzero in rows 0..=jj only.
-        let mut h = 0.0;
+    }
+    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
+    let rss: f64 = residuals.iter().zip(&wv).map(|(e, w)| w * e * e).sum();
+    // Row by row (k small): the k column streams are read in step, no scratch vectors.
+    let mut leverage = vec![0.0; n];
+    let g: Vec<f64> = (0..k * k)
+        .map(|idx| {
+            let (l, jj) = (idx % k, idx / k);
+            rinv[(l, jj)] / scales[l]
+        })
+        .collect();
+    let cols: Vec<&[f64]> = (0..k).map(col).collect();
+    let mut d = vec![0.0; k];
+    for (i, h) in leverage.iter_mut().enumerate() {
+        for l in 0..k {
+            d[l] = cols[l][i] - means[l];
+        }
+        let mut acc = 0.0;
         for jj in 0..k {
-            let mut u = 0.0;
-            for (l, al) in a.iter().enumerate().take(jj + 1) {
-                u += rinv[(l, jj)] * al;
-            }
-            h += u * u;
+            let gj = &g[jj * k..jj * k + jj + 1];
+            let u: f64 = gj.iter().zip(&d).map(|(a, b)| a * b).sum();
+            acc += u * u;
         }
-        let e = p.y[i] - yhat;
-        fitted[i] = yhat;
-        residuals[i] = e;
-        leverage[i] = h;
-        rss += w(i) * e * e;
+        *h = acc * wv[i];
     }
 
     let df = n - k;
@@ -590,13 +660,12 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
     let cov_scaled = &rinv * rinv.transpose();
     let cov = (&t * cov_scaled * t.transpose()) * sigma2;
     let std_error = cov.diagonal().map(|v| v.max(0.0).sqrt());
-    let yv: Vec<f64> = p.y.iter().copied().collect();
-    let wv: Vec<f64> = (0..n).map(w).collect();
+    let wopt = p.weights.map(|_| wv.as_slice());
     let (r2, adj_r2) = if p.has_intercept {
-        let r2 = stats::r2_centred(&yv, rss, Some(&wv));
+        let r2 = stats::r2_centred(y, rss, wopt);
         (r2, 1.0 - (1.0 - r2) * (n as f64 - 1.0) / df as f64)
     } else {
-        let r2 = stats::r2_uncentred(&yv, rss, Some(&wv));
+        let r2 = stats::r2_uncentred(y, rss, wopt);
         (r2, 1.0 - (1.0 - r2) * n as f64 / df as f64)
     };
     let sum_log_w = if p.weights.is_some() {
@@ -608,9 +677,9 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
         coef,
         cov,
         std_error,
-        fitted,
-        residuals,
-        leverage,
+        fitted: DVector::from_vec(fitted),
+        residuals: DVector::from_vec(residuals),
+        leverage: DVector::from_vec(leverage),
         weights: DVector::from_vec(wv),
         n,
         p: k,
@@ -707,7 +776,17 @@ pub fn polynomial_fit(
             message: format!("all x values are equal ({lo}); a polynomial needs distinct x"),
         });
     }
-    let tx = DMatrix::from_fn(x.len(), k, |i, j| ((x[i] - centre) / half).powi(j as i32));
+    // Columns 1, t, t², … filled by recurrence, column-major.
+    let n = x.len();
+    let mut buf = vec![1.0; n * k];
+    for j in 1..k {
+        let (prev, cur) = buf.split_at_mut(j * n);
+        let prev = &prev[(j - 1) * n..];
+        for ((c, p), xi) in cur[..n].iter_mut().zip(prev).zip(x) {
+            *c = p * ((xi - centre) / half);
+        }
+    }
+    let tx = DMatrix::from_vec(n, k, buf);
     let yv = DVector::from_column_slice(y);
     let wv = weights.map(DVector::from_column_slice);
     let names: Vec<String> = (0..k).map(|j| format!("x^{j}")).collect();
