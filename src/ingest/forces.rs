@@ -142,23 +142,15 @@ pub fn parse_plates(
     let ncol = names.len();
     let mut data: Vec<Vec<f64>> = (0..ncol).map(|_| Vec::with_capacity(nsamples)).collect();
     let mut lines_of = Vec::with_capacity(nsamples);
+    let mut row = Vec::with_capacity(ncol);
     for (ln, line) in it {
         if text::is_blank(line) {
             continue;
         }
-        let mut n = 0;
-        for cell in text::cells(line, b'\t').take(ncol) {
-            let v = text::finite(cell, path, ln, &names[n])?;
-            data[n].push(v);
-            n += 1;
-        }
-        if n < ncol {
-            return Err(IngestError::cell(
-                path,
-                ln,
-                names[n].clone(),
-                format!("row has {n} of {ncol} columns: the file is truncated or corrupt"),
-            ));
+        text::numeric_row(line, b'\t', ncol, &mut row)
+            .map_err(|e| e.into_ingest(path, ln, line, b'\t', &names))?;
+        for (d, v) in data.iter_mut().zip(&row) {
+            d.push(*v);
         }
         lines_of.push(ln);
     }

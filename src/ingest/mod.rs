@@ -9,6 +9,7 @@
 //! records what it assumed in [`Trial::notes`].
 pub mod c3d;
 pub mod forces;
+pub mod frame_csv;
 pub mod frame_detect;
 pub mod gaps;
 pub mod hamner;
@@ -241,10 +242,7 @@ pub fn read_trial(path: &Path, opts: &ReadOptions) -> Result<Trial, IngestError>
         Format::Winter => winter::read(path, opts),
         Format::TreadmillGrf => treadmill::read(path, opts),
         Format::C3d => c3d::read(path, opts),
-        f @ Format::FrameCsv => Err(IngestError::malformed(
-            path,
-            format!("{f:?} files are not readable yet in this version of gaitfit"),
-        )),
+        Format::FrameCsv => frame_csv::read(path, opts),
     }
 }
 

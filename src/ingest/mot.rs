@@ -150,53 +150,41 @@ pub fn parse_table(bytes: &[u8], path: &Path) -> Result<MotTable, IngestError> {
     let mut time = Vec::with_capacity(cap);
     let mut lines_of = Vec::with_capacity(cap);
     let mut columns: Vec<Vec<f64>> = (1..ncol).map(|_| Vec::with_capacity(cap)).collect();
+    let mut row: Vec<f64> = Vec::with_capacity(ncol);
     for (ln, line) in it {
         if text::is_blank(line) {
             continue;
         }
-        let mut n = 0usize;
-        let mut cells_iter: Box<dyn Iterator<Item = &[u8]>> = match delim {
-            Some(d) => Box::new(text::cells(line, d)),
-            None => Box::new(text::words(line)),
-        };
-        for cell in cells_iter.by_ref().take(ncol) {
-            let v = match text::num(cell) {
-                Num::Value(v) if v.is_finite() => v,
-                _ => {
-                    return Err(IngestError::cell(
-                        path,
-                        ln,
-                        all_names[n].clone(),
-                        format!("{:?} is not a finite number", text::text(cell)),
-                    ))
-                }
-            };
-            if n == 0 {
-                time.push(v);
-            } else {
-                columns[n - 1].push(v);
-            }
-            n += 1;
-        }
-        if n < ncol {
-            // Roll back the partial row so no partial output can escape, then report.
-            time.truncate(lines_of.len());
-            return Err(IngestError::cell(
-                path,
-                ln,
-                all_names[n].clone(),
-                format!(
-                    "row has {n} of {ncol} columns: the file is truncated or a cell is missing"
+        if let Some(d) = delim {
+            text::numeric_row(line, d, ncol, &mut row)
+                .map_err(|e| e.into_ingest(path, ln, line, d, &all_names))?;
+        } else if let Err(bad) = parse_row(text::words(line), ncol, &mut row) {
+            return Err(match bad {
+                RowError::Cell(n, cell) => IngestError::cell(
+                    path,
+                    ln,
+                    all_names[n].clone(),
+                    format!("{cell:?} is not a finite number"),
                 ),
-            ));
+                RowError::Short(n) => IngestError::cell(
+                    path,
+                    ln,
+                    all_names[n].clone(),
+                    format!(
+                        "row has {n} of {ncol} columns: the file is truncated or a cell is missing"
+                    ),
+                ),
+                RowError::Long => IngestError::cell(
+                    path,
+                    ln,
+                    format!("column {}", ncol + 1),
+                    format!("more cells than the {ncol} column names"),
+                ),
+            });
         }
-        if cells_iter.any(|c| !text::trim(c).is_empty()) {
-            return Err(IngestError::cell(
-                path,
-                ln,
-                format!("column {}", ncol + 1),
-                format!("more cells than the {ncol} column names"),
-            ));
+        time.push(row[0]);
+        for (c, v) in columns.iter_mut().zip(&row[1..]) {
+            c.push(*v);
         }
         lines_of.push(ln);
     }
@@ -238,6 +226,37 @@ pub fn parse_table(bytes: &[u8], path: &Path) -> Result<MotTable, IngestError> {
         in_degrees,
         is_angle,
     })
+}
+
+enum RowError {
+    /// Column index and the cell's text.
+    Cell(usize, String),
+    /// Only this many cells.
+    Short(usize),
+    /// Non-empty cells beyond the last column.
+    Long,
+}
+
+/// Parses one row of `ncol` finite numbers into `row` (cleared first).
+fn parse_row<'a>(
+    mut cells: impl Iterator<Item = &'a [u8]>,
+    ncol: usize,
+    row: &mut Vec<f64>,
+) -> Result<(), RowError> {
+    row.clear();
+    for (n, cell) in cells.by_ref().take(ncol).enumerate() {
+        match text::num(cell) {
+            Num::Value(v) if v.is_finite() => row.push(v),
+            _ => return Err(RowError::Cell(n, text::text(cell))),
+        }
+    }
+    if row.len() < ncol {
+        return Err(RowError::Short(row.len()));
+    }
+    if cells.any(|c| !text::trim(c).is_empty()) {
+        return Err(RowError::Long);
+    }
+    Ok(())
 }
 
 /// One GRF column group found in a table.

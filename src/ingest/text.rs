@@ -3,8 +3,9 @@
 //!
 //! Why hand-rolled instead of the `csv` crate: the motion-capture text formats have free-form
 //! headers of several lines before the table, tab-separated cells where an empty cell means "marker
-//! missing", and a 30 s trial holds ~10⁶ numbers; parsing from borrowed slices keeps a trial well
-//! under the 50 ms budget (see `benches/ingest.rs`).
+//! missing", and a 30 s trial holds ~10⁶ numbers; parsing from borrowed slices (cells found with
+//! `memchr`, numbers with `fast-float2`) keeps a trial well under the 50 ms budget (see
+//! `benches/ingest.rs`).
 use super::IngestError;
 use std::path::Path;
 
@@ -15,12 +16,16 @@ pub(crate) fn read_bytes(path: &Path) -> Result<Vec<u8>, IngestError> {
 
 /// Lines of `bytes` with their 1-based line numbers; the `\n` and a trailing `\r` are removed.
 pub(crate) fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, &[u8])> {
-    let body = bytes.strip_suffix(b"\n").unwrap_or(bytes);
-    body.split(|&b| b == b'\n')
+    let body = if bytes.is_empty() {
+        None
+    } else {
+        Some(bytes.strip_suffix(b"\n").unwrap_or(bytes))
+    };
+    body.into_iter()
+        .flat_map(|b| cells(b, b'\n'))
         .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
         .enumerate()
         .map(|(i, l)| (i + 1, l))
-        .filter(move |_| !bytes.is_empty())
 }
 
 /// True when the line holds nothing but spaces, tabs and commas.
@@ -30,7 +35,14 @@ pub(crate) fn is_blank(line: &[u8]) -> bool {
 
 /// Cells of a line split on `delim` (every delimiter counts: empty cells are kept).
 pub(crate) fn cells(line: &[u8], delim: u8) -> impl Iterator<Item = &[u8]> {
-    line.split(move |&b| b == delim)
+    let mut start = 0usize;
+    let mut ends = memchr::memchr_iter(delim, line).chain(std::iter::once(line.len()));
+    std::iter::from_fn(move || {
+        let end = ends.next()?;
+        let cell = &line[start..end];
+        start = end + 1;
+        Some(cell)
+    })
 }
 
 /// Cells of a line split on runs of spaces and tabs (no empty cells).
@@ -79,6 +91,105 @@ pub(crate) fn num(cell: &[u8]) -> Num {
     {
         Some(v) => Num::Value(v),
         None => Num::Bad,
+    }
+}
+
+/// Parses a row of `ncol` delimited finite numbers into `out` (cleared first): the hot loop of
+/// every numeric table. Cells may carry spaces around the number. On failure returns the
+/// 0-based column and what went wrong; non-empty cells beyond `ncol` are an error too.
+#[inline]
+pub(crate) fn numeric_row(
+    line: &[u8],
+    delim: u8,
+    ncol: usize,
+    out: &mut Vec<f64>,
+) -> Result<(), RowError> {
+    out.clear();
+    let mut rest = line;
+    loop {
+        let end = memchr::memchr(delim, rest).unwrap_or(rest.len());
+        let cell = &rest[..end];
+        if out.len() == ncol {
+            if !trim_spaces(cell).is_empty() {
+                return Err(RowError::Long);
+            }
+        } else {
+            let t = trim_spaces(cell);
+            match fast_float2::parse_partial::<f64, _>(t) {
+                Ok((v, n)) if n == t.len() && v.is_finite() => out.push(v),
+                _ if t.is_empty() => return Err(RowError::Empty(out.len())),
+                _ => return Err(RowError::Bad(out.len())),
+            }
+        }
+        if end == rest.len() {
+            break;
+        }
+        rest = &rest[end + 1..];
+    }
+    if out.len() < ncol {
+        return Err(RowError::Short(out.len()));
+    }
+    Ok(())
+}
+
+/// Why [`numeric_row`] failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum RowError {
+    /// The cell in this column is not a finite number.
+    Bad(usize),
+    /// The cell in this column is empty.
+    Empty(usize),
+    /// Only this many cells.
+    Short(usize),
+    /// Non-empty cells beyond the last column.
+    Long,
+}
+
+impl RowError {
+    /// The error for row `row` of `path`, with column names `names`.
+    pub(crate) fn into_ingest(
+        self,
+        path: &Path,
+        row: usize,
+        line: &[u8],
+        delim: u8,
+        names: &[String],
+    ) -> IngestError {
+        let name = |i: usize| {
+            names
+                .get(i)
+                .cloned()
+                .unwrap_or_else(|| format!("column {}", i + 1))
+        };
+        match self {
+            RowError::Bad(i) => {
+                let cell = cells(line, delim).nth(i).map(text).unwrap_or_default();
+                IngestError::cell(
+                    path,
+                    row,
+                    name(i),
+                    format!("{cell:?} is not a finite number"),
+                )
+            }
+            RowError::Empty(i) => {
+                IngestError::cell(path, row, name(i), "empty cell: give a number")
+            }
+            RowError::Short(n) => IngestError::cell(
+                path,
+                row,
+                name(n),
+                format!(
+                    "row has {n} of {} columns: the file is truncated or corrupt",
+                    names.len()
+                ),
+            ),
+            RowError::Long => IngestError::cell(
+                path,
+                row,
+                format!("column {}", names.len() + 1),
+                format!("more cells than the {} column names", names.len()),
+            ),
+        }
     }
 }
 
