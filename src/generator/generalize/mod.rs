@@ -32,6 +32,7 @@ pub mod geometry;
 pub mod mu;
 pub mod phi;
 pub mod pose;
+pub mod prototype;
 pub mod psi;
 pub mod synthetic;
 pub mod walk_data;
