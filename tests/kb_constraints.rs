@@ -71,6 +71,8 @@ fn body_like(b: &Anthropometry, k: &[f64; 3]) -> Anthropometry {
         b.ball_to_toe() * k[2],
     )
     .unwrap()
+    .with_ball_height(b.ball_height() * k[2])
+    .unwrap()
 }
 
 fn stance_foot_is_planted(w: &WalkData, mu: &MuFunctions) -> Result<(), TestCaseError> {

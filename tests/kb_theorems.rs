@@ -27,6 +27,8 @@ fn other_body(b: &Anthropometry, k: &[f64; 7]) -> Anthropometry {
         b.ball_to_toe() * k[5] * k[6],
     )
     .unwrap()
+    .with_ball_height(b.ball_height() * k[6])
+    .unwrap()
 }
 
 fn factors() -> impl Strategy<Value = [f64; 7]> {

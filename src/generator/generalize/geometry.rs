@@ -46,43 +46,45 @@ pub struct FootPoints {
 
 /// The foot's points when it rests on `pivot` with foot angle `f` and meta angle `m` (the angle
 /// between floor and toes; used only on the toe rocker). On the heel rocker the toes continue
-/// the sole; on the ball rocker they lie flat.
+/// the sole; on the ball rocker they lie flat. The toe hinge J sits `ball_height` above the ball
+/// sole point (0 for Table 2's foot): on the ball rocker the foot turns about J, which stays
+/// still because the flat toes carry it.
 pub fn foot_on_pivot(b: &Anthropometry, pivot: Pivot, f: f64, m: f64) -> FootPoints {
     let hb = b.heel_to_ball();
-    let (hn, an, bt) = (b.heel_to_n(), b.ankle_to_n(), b.ball_to_toe());
+    let (hn, an, bt, hm) = (
+        b.heel_to_n(),
+        b.ankle_to_n(),
+        b.ball_to_toe(),
+        b.ball_height(),
+    );
+    let add = |p: P2, q: P2| [p[0] + q[0], p[1] + q[1]];
     match pivot {
         Pivot::Heel(x) => {
             let heel = [x, 0.0];
-            let a = rotate(f, hn, an);
-            let bl = rotate(f, hb, 0.0);
-            let tt = rotate(f, hb + bt, 0.0);
+            let j = add(heel, rotate(f, hb, hm));
             FootPoints {
-                ankle: [x + a[0], a[1]],
+                ankle: add(heel, rotate(f, hn, an)),
                 heel,
-                ball: [x + bl[0], bl[1]],
-                toe: [x + tt[0], tt[1]],
+                ball: add(j, rotate(f, 0.0, -hm)),
+                toe: add(j, rotate(f, bt, -hm)),
             }
         }
         Pivot::Ball(x) => {
-            let ball = [x, 0.0];
-            let a = rotate(f, hn - hb, an);
-            let h = rotate(f, -hb, 0.0);
+            let j = [x, hm];
             FootPoints {
-                ankle: [x + a[0], a[1]],
-                heel: [x + h[0], h[1]],
-                ball,
+                ankle: add(j, rotate(f, hn - hb, an - hm)),
+                heel: add(j, rotate(f, -hb, -hm)),
+                ball: [x, 0.0],
                 toe: [x + bt, 0.0],
             }
         }
         Pivot::Toe(x) => {
-            let (sm, cm) = m.sin_cos();
-            let ball = [x - bt * cm, bt * sm];
-            let a = rotate(f, hn - hb, an);
-            let h = rotate(f, -hb, 0.0);
+            // The toe segment turns about its tip, heel side up (clockwise by m).
+            let j = add([x, 0.0], rotate(-m, -bt, hm));
             FootPoints {
-                ankle: [ball[0] + a[0], ball[1] + a[1]],
-                heel: [ball[0] + h[0], ball[1] + h[1]],
-                ball,
+                ankle: add(j, rotate(f, hn - hb, an - hm)),
+                heel: add(j, rotate(f, -hb, -hm)),
+                ball: add(j, rotate(-m, 0.0, -hm)),
                 toe: [x, 0.0],
             }
         }
@@ -92,17 +94,16 @@ pub fn foot_on_pivot(b: &Anthropometry, pivot: Pivot, f: f64, m: f64) -> FootPoi
 /// A free (swing) foot placed by its ankle and foot angle; the toes are bent up from the sole by
 /// `toe_rel` (rad, positive = toes extended).
 pub fn foot_from_ankle(b: &Anthropometry, ankle: P2, f: f64, toe_rel: f64) -> FootPoints {
-    let hb = b.heel_to_ball();
+    let add = |p: P2, q: P2| [p[0] + q[0], p[1] + q[1]];
+    let hm = b.ball_height();
     let a = rotate(f, b.heel_to_n(), b.ankle_to_n());
     let heel = [ankle[0] - a[0], ankle[1] - a[1]];
-    let bl = rotate(f, hb, 0.0);
-    let ball = [heel[0] + bl[0], heel[1] + bl[1]];
-    let t = rotate(f + toe_rel, b.ball_to_toe(), 0.0);
+    let j = add(heel, rotate(f, b.heel_to_ball(), hm));
     FootPoints {
         ankle,
         heel,
-        ball,
-        toe: [ball[0] + t[0], ball[1] + t[1]],
+        ball: add(j, rotate(f + toe_rel, 0.0, -hm)),
+        toe: add(j, rotate(f + toe_rel, b.ball_to_toe(), -hm)),
     }
 }
 
@@ -187,7 +188,13 @@ mod tests {
 
     #[test]
     fn pivots_agree_at_the_transitions() {
-        let b = body();
+        for h in [0.0, 0.02] {
+            pivots_agree(&body().with_ball_height(h).unwrap());
+        }
+    }
+
+    fn pivots_agree(b: &Anthropometry) {
+        let b = *b;
         let hb = b.heel_to_ball();
         let h = foot_on_pivot(&b, Pivot::Heel(0.2), 0.0, 0.0);
         let ba = foot_on_pivot(&b, Pivot::Ball(0.2 + hb), 0.0, 0.0);

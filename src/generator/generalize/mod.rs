@@ -28,6 +28,7 @@
 //!    length 70.69 and leg length 73.90 match Winter's data in cm).
 //!
 //! With these, Theorems 1–5 hold to rounding (property tests to 1e-9).
+pub mod figure;
 pub mod geometry;
 pub mod mu;
 pub mod phi;
@@ -43,6 +44,10 @@ pub use psi::psi;
 pub use walk_data::{AngleSequence, Anthropometry, Moments, PathSequence, TimedSequence, WalkData};
 
 use crate::generator::GenerateError;
+
+/// The μ-function slopes α₁…α₄ (rad/m) used when no fit is given: the values of the committed
+/// `fits/kb-mu.json` (checked by `tests/kb_mu_fit.rs`).
+pub const DEFAULT_ALPHA: [f64; 4] = [0.1, 0.3, 0.5, 0.5];
 
 /// A prototype walk W(S*, sl*) with its μ-functions: the generator of every other step.
 #[derive(Debug, Clone)]

@@ -29,11 +29,14 @@
 //! - FGM: the foot angle first within [`FLAT_FOOT_TOLERANCE_RAD`] of flat after heel strike;
 //!   MOM: the ball marker's last rise [`BALL_LIFT_M`] above its flat height before toe off;
 //!   TOM: toe off (as the swing foot's time in the step).
-//! - μ* are read off the data (μ₂* = F₁(0), μ₃* = −F₂(end), μ₄* = M(end), μ₁* = the model knee
-//!   flexion at heel strike from the hip–ankle distance), and the raw W is made consistent by φ₁
+//! - μ* are read off the data (μ₂* = F₁(0), μ₃* = −F₂(end), μ₄* = M(end), μ₁* = the marker
+//!   knee flexion at heel strike); thigh and shin (marker means, the thigh from the pelvis
+//!   centre) are scaled together so the model leg bends by μ₁* at heel strike (skin artifact
+//!   makes marker-mean legs ≈ 1 cm too short to reach the hip there); the raw W is made
+//!   consistent by φ₁
 //!   (which pins the hip heights, blends F₃ onto the heel-strike angle and maps A onto the
 //!   model's toe-off and heel-strike ankles); [`PrototypeReport`] says how far each end moved.
-use super::geometry::{foot_on_pivot, knee_flexion_for_distance, Pivot};
+use super::geometry::{foot_on_pivot, hip_ankle_distance, Pivot};
 use super::mu::MuFunctions;
 use super::phi::phi;
 use super::walk_data::{Anthropometry, Moments, TimedSequence, WalkData};
@@ -93,6 +96,11 @@ pub struct PrototypeReport {
     pub moments: [f64; 3],
     /// μ₁*…μ₄* (rad).
     pub mu_star: [f64; 4],
+    /// Factor applied to the marker-mean thigh and shin so the model knee at heel strike bends
+    /// as the measured one (see the module docs).
+    pub leg_scale: f64,
+    /// Largest hip lowering the prototype step itself needs for both legs to reach (m).
+    pub max_hip_drop_m: f64,
 }
 
 /// The flat-foot window, as fractions of stance after heel strike: after the heel rocker, before
@@ -436,18 +444,31 @@ pub fn build_prototype(
             .collect(),
     )?;
 
+    // μ* from the data. μ₁* is the measured (marker) knee flexion at heel strike; the leg's
+    // two segments are scaled together so that the model leg, from H(0) to the model's
+    // heel-strike ankle, bends exactly that much. With the bare marker means (skin artifact moves
+    // Winter's knee–ankle distance by ±1.5 cm) the model leg is ≈ 1 cm too short to reach the
+    // hip at heel strike and would be straight there, where the real knee is flexed ≈ 3°.
+    let mu2 = foot1.first()[0];
+    let mu3 = -foot2.last()[0];
+    let mu4 = meta_seq.last()[0];
+    let (hh, kk, aa) = (at(&leg.hip, hs0), at(&leg.knee, hs0), at(&leg.ankle, hs0));
+    let mu1 = (angle(hh, kk) - angle(kk, aa)).abs();
+    let a0 = foot_on_pivot(&body, Pivot::Heel(0.0), mu2, 0.0).ankle;
+    let d0 = dist(hip.first(), a0);
+    let leg_scale = d0 / hip_ankle_distance(&body, mu1);
+    let body = Anthropometry::new(
+        leg_scale * body.thigh(),
+        leg_scale * body.shin(),
+        body.heel_to_n(),
+        body.ball_to_n(),
+        body.ankle_to_n(),
+        body.ball_to_toe(),
+    )?;
+    let mu_star = [mu1, mu2, mu3, mu4];
     let raw = WalkData::new(
         body, sl, sl, moments, hip, foot1, foot2, foot3, meta_seq, ankle,
     )?;
-
-    // μ* from the data; μ₁* from the model stance ankle and H at heel strike.
-    let mu2 = raw.foot1().first()[0];
-    let mu3 = -raw.foot2().last()[0];
-    let mu4 = raw.meta().last()[0];
-    let a0 = foot_on_pivot(&body, Pivot::Heel(0.0), mu2, 0.0).ankle;
-    let d0 = dist(raw.hip().first(), a0);
-    let mu1 = knee_flexion_for_distance(&body, d0).unwrap_or(0.0);
-    let mu_star = [mu1, mu2, mu3, mu4];
     let mu = MuFunctions::new(alpha, mu_star, sl, body.leg_length())?;
     let w = phi(&raw, 1.0, sl, &mu)?;
 
@@ -465,6 +486,14 @@ pub fn build_prototype(
         ],
         moments: [fgm, mom, tom],
         mu_star,
+        leg_scale,
+        max_hip_drop_m: (0..=200)
+            .map(|i| {
+                super::pose::pose(&w, &mu, i as f64 / 200.0)
+                    .map(|p| p.hip_drop)
+                    .unwrap_or(f64::NAN)
+            })
+            .fold(0.0, f64::max),
     };
     Ok((w, mu, report))
 }
@@ -532,5 +561,281 @@ pub fn winter_leg(
             toe_off: t(b)?,
             next_heel_strike: t(c)?,
         },
+    ))
+}
+
+/// A prototype walk with what the generator needs besides W: the μ values it was measured with,
+/// its step duration, and where it came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prototype {
+    /// W(S*, sl*), consistent (φ₁ is the identity on it).
+    pub walk: WalkData,
+    /// μ₁*…μ₄* (rad).
+    pub mu_star: [f64; 4],
+    /// The measured step's duration (s).
+    pub step_duration_s: f64,
+    /// Where the markers came from.
+    pub source: String,
+    /// Whom to cite.
+    pub citation: String,
+}
+
+impl Prototype {
+    /// The μ-functions of this prototype with slopes `alpha` (rad/m).
+    pub fn mu(&self, alpha: [f64; 4]) -> Result<MuFunctions, GenerateError> {
+        MuFunctions::new(
+            alpha,
+            self.mu_star,
+            self.walk.step_length(),
+            self.walk.body().leg_length(),
+        )
+    }
+
+    /// The prototype bundled with gaitfit: Winter's walk (`data/prototype_winter.json`).
+    pub fn bundled() -> Prototype {
+        // The file is committed and checked by tests/kb_prototype.rs; parsing it cannot fail
+        // unless the repository itself is broken.
+        match Prototype::from_json(BUNDLED_JSON, "data/prototype_winter.json") {
+            Ok(p) => p,
+            Err(e) => panic!("the bundled prototype data/prototype_winter.json is broken: {e}"),
+        }
+    }
+
+    /// Parses a prototype file's text (`what` names it in errors).
+    pub fn from_json(text: &str, what: &str) -> Result<Prototype, String> {
+        let f: PrototypeFile = serde_json::from_str(text)
+            .map_err(|e| format!("{what}: not a gaitfit prototype: {e}"))?;
+        if f.format != PROTOTYPE_FORMAT {
+            return Err(format!(
+                "{what}: format {:?}, expected {PROTOTYPE_FORMAT:?}",
+                f.format
+            ));
+        }
+        let wrap = |e: GenerateError| format!("{what}: {e}");
+        let b = &f.body;
+        let body = Anthropometry::new(
+            b.thigh_m,
+            b.shin_m,
+            b.heel_to_n_m,
+            b.ball_to_n_m,
+            b.ankle_to_n_m,
+            b.ball_to_toe_m,
+        )
+        .and_then(|a| a.with_ball_height(b.ball_height_m))
+        .map_err(wrap)?;
+        let moments = Moments::new(f.moments.fgm_step, f.moments.mom_step, f.moments.tom_step)
+            .map_err(wrap)?;
+        let path = |name: &str, p: &PathFile| {
+            if p.x_m.len() != p.t_step.len() || p.y_m.len() != p.t_step.len() {
+                return Err(format!(
+                    "{what}: {name}: t_step, x_m and y_m differ in length"
+                ));
+            }
+            TimedSequence::new(
+                name,
+                p.t_step.clone(),
+                p.x_m.iter().zip(&p.y_m).map(|(&x, &y)| [x, y]).collect(),
+            )
+            .map_err(wrap)
+        };
+        let angle = |name: &str, a: &AngleFile| {
+            if a.angle_rad.len() != a.t_step.len() {
+                return Err(format!(
+                    "{what}: {name}: t_step and angle_rad differ in length"
+                ));
+            }
+            TimedSequence::new(
+                name,
+                a.t_step.clone(),
+                a.angle_rad.iter().map(|&v| [v]).collect(),
+            )
+            .map_err(wrap)
+        };
+        let walk = WalkData::new(
+            body,
+            f.step_length_m,
+            f.step_length_before_m,
+            moments,
+            path("hip", &f.hip)?,
+            angle("foot1", &f.foot1)?,
+            angle("foot2", &f.foot2)?,
+            angle("foot3", &f.foot3)?,
+            angle("meta", &f.meta)?,
+            path("ankle", &f.ankle)?,
+        )
+        .map_err(wrap)?;
+        if !(f.step_duration_s.is_finite() && f.step_duration_s > 0.0) {
+            return Err(format!("{what}: step_duration_s must be positive"));
+        }
+        let p = Prototype {
+            walk,
+            mu_star: f.mu_star_rad,
+            step_duration_s: f.step_duration_s,
+            source: f.source,
+            citation: f.citation,
+        };
+        p.mu([0.0; 4]).map_err(wrap)?;
+        Ok(p)
+    }
+
+    /// The prototype file's text (JSON, every number at full precision), with the command that
+    /// regenerates it and the build report.
+    pub fn to_json(&self, regenerate: &str, report: Option<&PrototypeReport>) -> String {
+        let w = &self.walk;
+        let b = w.body();
+        let path = |s: &super::walk_data::PathSequence| PathFile {
+            t_step: s.times().to_vec(),
+            x_m: s.values().iter().map(|v| v[0]).collect(),
+            y_m: s.values().iter().map(|v| v[1]).collect(),
+        };
+        let angle = |s: &super::walk_data::AngleSequence| AngleFile {
+            t_step: s.times().to_vec(),
+            angle_rad: s.values().iter().map(|v| v[0]).collect(),
+        };
+        let f = PrototypeFile {
+            format: PROTOTYPE_FORMAT.into(),
+            source: self.source.clone(),
+            citation: self.citation.clone(),
+            regenerate: regenerate.into(),
+            body: BodyFile {
+                thigh_m: b.thigh(),
+                shin_m: b.shin(),
+                heel_to_n_m: b.heel_to_n(),
+                ball_to_n_m: b.ball_to_n(),
+                ankle_to_n_m: b.ankle_to_n(),
+                ball_to_toe_m: b.ball_to_toe(),
+                ball_height_m: b.ball_height(),
+            },
+            step_length_m: w.step_length(),
+            step_length_before_m: w.step_length_before(),
+            step_duration_s: self.step_duration_s,
+            moments: MomentsFile {
+                fgm_step: w.moments().fgm(),
+                mom_step: w.moments().mom(),
+                tom_step: w.moments().tom(),
+            },
+            mu_star_rad: self.mu_star,
+            build: report.map(|r| BuildFile {
+                raw_hip_travel_m: r.raw_hip_travel_m,
+                foot_line_offset_rad: r.foot_line_offset_rad,
+                toe_line_offset_rad: r.toe_line_offset_rad,
+                ankle_to_shift_m: r.ankle_to_shift_m,
+                ankle_hs_shift_m: r.ankle_hs_shift_m,
+                hip_pin_m: r.hip_pin_m,
+            }),
+            hip: path(w.hip()),
+            foot1: angle(w.foot1()),
+            foot2: angle(w.foot2()),
+            foot3: angle(w.foot3()),
+            meta: angle(w.meta()),
+            ankle: path(w.ankle()),
+        };
+        // Serializing plain numbers and strings cannot fail.
+        serde_json::to_string_pretty(&f).unwrap_or_default() + "\n"
+    }
+}
+
+/// The bundled prototype file's text.
+pub const BUNDLED_JSON: &str = include_str!("../../../data/prototype_winter.json");
+
+/// Format tag of prototype files.
+pub const PROTOTYPE_FORMAT: &str = "gaitfit-ko-badler-prototype-1";
+
+/// Citation of the bundled prototype's data.
+pub const WINTER_CITATION: &str = "Winter, D. A. (1990). Biomechanics and Motor Control of Human \
+Movement, 2nd ed., Wiley: Appendix A, Table A.1 (raw) and its filtered version, as \
+redistributed by BMClab (Federal University of ABC, repository BMClab/BMC, CC BY 4.0): \
+bmclab/wn35b.txt";
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PrototypeFile {
+    format: String,
+    source: String,
+    citation: String,
+    regenerate: String,
+    body: BodyFile,
+    step_length_m: f64,
+    step_length_before_m: f64,
+    step_duration_s: f64,
+    moments: MomentsFile,
+    mu_star_rad: [f64; 4],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    build: Option<BuildFile>,
+    hip: PathFile,
+    foot1: AngleFile,
+    foot2: AngleFile,
+    foot3: AngleFile,
+    meta: AngleFile,
+    ankle: PathFile,
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BodyFile {
+    thigh_m: f64,
+    shin_m: f64,
+    heel_to_n_m: f64,
+    ball_to_n_m: f64,
+    ankle_to_n_m: f64,
+    ball_to_toe_m: f64,
+    #[serde(default)]
+    ball_height_m: f64,
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MomentsFile {
+    fgm_step: f64,
+    mom_step: f64,
+    tom_step: f64,
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BuildFile {
+    raw_hip_travel_m: f64,
+    foot_line_offset_rad: f64,
+    toe_line_offset_rad: f64,
+    ankle_to_shift_m: f64,
+    ankle_hs_shift_m: f64,
+    hip_pin_m: [f64; 2],
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathFile {
+    t_step: Vec<f64>,
+    x_m: Vec<f64>,
+    y_m: Vec<f64>,
+}
+
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AngleFile {
+    t_step: Vec<f64>,
+    angle_rad: Vec<f64>,
+}
+
+/// Builds the prototype from one of Winter's tables (`WinterTableA1.txt` or `wn35b.txt`).
+pub fn winter_prototype(
+    path: &std::path::Path,
+) -> Result<(Prototype, PrototypeReport), crate::Error> {
+    let trial = crate::ingest::winter::read(path, &crate::ingest::ReadOptions::default())?;
+    let (leg, ev) = winter_leg(&trial)?;
+    let (walk, mu, report) = build_prototype(&leg, &ev, [0.0; 4])?;
+    let file = path
+        .file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok((
+        Prototype {
+            walk,
+            mu_star: mu.mu_star(),
+            step_duration_s: report.step_duration_s,
+            source: format!("bmclab/{file} (right leg, frames 28–97; events 28, 70, 97)"),
+            citation: WINTER_CITATION.into(),
+        },
+        report,
     ))
 }

@@ -23,6 +23,9 @@ pub fn synthetic_walk(seed: u64) -> Result<(WalkData, MuFunctions), GenerateErro
         u(0.05, 0.08),
         u(0.05, 0.08),
     )?;
+    // Half the walks hinge the toes above the sole, as gaitfit's figure does.
+    let hm = if seed % 2 == 1 { u(0.01, 0.03) } else { 0.0 };
+    let body = body.with_ball_height(hm)?;
     let sl = u(0.6, 0.8) * body.leg_length() / 0.8;
     let (fgm, mom, tom) = (u(0.12, 0.2), u(1.02, 1.12), u(0.18, 0.26));
     let moments = Moments::new(fgm, mom, tom)?;

@@ -154,6 +154,10 @@ fn param(name: &str, value: f64, message: &str) -> GenerateError {
 /// segments and the foot. The foot is the rigid triangle heel–ankle–ball plus a toe segment
 /// hinged at the ball; N is the foot of the perpendicular from the ankle onto the sole line
 /// (heel–ball), so `heel_to_n + ball_to_n` is the heel-to-ball length.
+///
+/// The toe hinge (metatarsal joint) may sit `ball_height` above the sole, straight above the
+/// ball sole point, as in gaitfit's figure ([`crate::generator::skeleton`]); Table 2's foot and
+/// the marker-built prototype hinge on the sole (height 0, the default).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Anthropometry {
     thigh: f64,
@@ -162,6 +166,7 @@ pub struct Anthropometry {
     ball_to_n: f64,
     ankle_to_n: f64,
     ball_to_toe: f64,
+    ball_height: f64,
 }
 
 impl Anthropometry {
@@ -197,7 +202,39 @@ impl Anthropometry {
             ball_to_n,
             ankle_to_n,
             ball_to_toe,
+            ball_height: 0.0,
         })
+    }
+
+    /// The same body with the toe hinge `h` above the sole (m, ≥ 0, below the ankle).
+    pub fn with_ball_height(mut self, h: f64) -> Result<Self, GenerateError> {
+        if !(h.is_finite() && h >= 0.0 && h < self.ankle_to_n) {
+            return Err(param(
+                "ball_height",
+                h,
+                "the toe hinge must lie between the sole and the ankle's height (m)",
+            ));
+        }
+        self.ball_height = h;
+        Ok(self)
+    }
+
+    /// The generalization's view of gaitfit's figure: thigh and shank lengths, and the foot of
+    /// [`crate::generator::anthropometry::FootGeometry`] (heel → ankle l₈, ankle height l₉,
+    /// ankle → metatarsal l₅, metatarsal → toe l₆, metatarsal joint height).
+    pub fn from_figure(
+        a: &crate::generator::anthropometry::Anthropometry,
+    ) -> Result<Self, GenerateError> {
+        let f = &a.foot;
+        Anthropometry::new(
+            a.thigh.length_m,
+            a.shank.length_m,
+            f.hind_foot_m,
+            f.mid_foot_m,
+            f.ankle_height_m,
+            f.toe_m,
+        )?
+        .with_ball_height(f.metatarsal_height_m)
     }
 
     /// Thigh length, hip to knee (m).
@@ -221,9 +258,13 @@ impl Anthropometry {
     pub fn ankle_to_n(&self) -> f64 {
         self.ankle_to_n
     }
-    /// Ball to toe tip (m).
+    /// Ball to toe tip along the sole (m).
     pub fn ball_to_toe(&self) -> f64 {
         self.ball_to_toe
+    }
+    /// Height of the toe hinge (metatarsal joint) above the sole (m).
+    pub fn ball_height(&self) -> f64 {
+        self.ball_height
     }
     /// Leg length ll(S) = thigh + shin (§3).
     pub fn leg_length(&self) -> f64 {
@@ -262,7 +303,8 @@ impl Anthropometry {
             alpha * self.ball_to_n,
             alpha * self.ankle_to_n,
             alpha * self.ball_to_toe,
-        )
+        )?
+        .with_ball_height(alpha * self.ball_height)
     }
     /// S₂/S₁ of eq. 3: the leg-length ratio ll(S₂)/ll(S₁).
     pub fn ratio_to(&self, other: &Anthropometry) -> f64 {
@@ -521,6 +563,7 @@ impl WalkData {
             a.ball_to_n - b.ball_to_n,
             a.ankle_to_n - b.ankle_to_n,
             a.ball_to_toe - b.ball_to_toe,
+            a.ball_height - b.ball_height,
             self.step_length - other.step_length,
             self.step_length_before - other.step_length_before,
             self.moments.fgm - other.moments.fgm,
