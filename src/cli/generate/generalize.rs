@@ -23,9 +23,17 @@ use anyhow::{anyhow, bail, Context};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Arguments of `gaitfit generate generalize`.
+/// Arguments of `gaitfit generate generalize` (boxed: they are many).
 #[derive(Debug, clap::Args)]
 pub struct Args {
+    /// The options.
+    #[command(flatten)]
+    pub options: Box<Options>,
+}
+
+/// The options of `gaitfit generate generalize`.
+#[derive(Debug, clap::Args)]
+pub struct Options {
     /// Prototype walk file (JSON written by `--write-prototype`); default: the bundled Winter
     /// prototype.
     #[arg(long, value_name = "FILE")]
@@ -70,6 +78,7 @@ pub struct Args {
 
 /// Runs `gaitfit generate generalize`.
 pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
+    let args = &*args.options;
     let (proto, source) = if let Some(p) = &args.build_prototype {
         let (proto, report) = winter_prototype(p)?;
         eprintln!(
