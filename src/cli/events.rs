@@ -37,6 +37,9 @@ pub struct Args {
     /// Print a per-trial summary (steps, cadence, step length, stance, double support/flight).
     #[arg(long)]
     pub summary: bool,
+    /// Print what the readers and the detection assumed or found, per trial (to stderr).
+    #[arg(short, long)]
+    pub verbose: bool,
     /// Which events build the steps: auto (force with per-foot plates, else Zeni), force,
     /// zeni, zeni-velocity, reference.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
@@ -294,6 +297,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     }
     if args.summary {
         print!("{}", summary(&ok));
+    }
+    if args.verbose {
         for r in &ok {
             for n in &r.notes {
                 eprintln!("{}: {n}", r.label);

@@ -161,7 +161,8 @@ fn percentile_range(x: &[f64], lo: f64, hi: f64) -> f64 {
 }
 
 /// Turning points of `x` confirmed by a reversal of at least `delta`: `(index, is_maximum)`,
-/// alternating maxima and minima. The last, unconfirmed turning point is not returned.
+/// alternating maxima and minima. The last turning point needs only a reversal of `delta/10`
+/// before the end of the record (trimmed overground trials end soon after a heel strike).
 pub fn hysteresis_extrema(x: &[f64], delta: f64) -> Vec<(usize, bool)> {
     #[derive(PartialEq)]
     enum State {
@@ -214,6 +215,14 @@ pub fn hysteresis_extrema(x: &[f64], delta: f64) -> Vec<(usize, bool)> {
                 }
             }
         }
+    }
+    // A record cut shortly after the last turning point: accept it once the signal has come
+    // back by a tenth of the hysteresis (the caller still drops extrema at the very edge).
+    let last = x[x.len() - 1];
+    match state {
+        State::SeekMax if x[imax] - last >= 0.1 * delta => out.push((imax, true)),
+        State::SeekMin if last - x[imin] >= 0.1 * delta => out.push((imin, false)),
+        _ => {}
     }
     out
 }

@@ -12,7 +12,7 @@
 //!   H of the running paper's eq. 3 from the pelvis height at A's toe off (`y1`) and B's heel
 //!   strike (`y2`): `H = (t_flight − 2(y1 − y2)/(g·t_flight))² · g/8`. H is the apex of the
 //!   ballistic pelvis path above `y1`; the measured apex above `y1` during the flight is written
-//!   beside it (`flight_height_peak_m`) as the check;
+//!   beside it (`pelvis_apex_m`) as the check;
 //! - step length: footprints in the belt frame. With heel markers,
 //!   `sl = fwd(heel_B(t_B)) − fwd(heel_A(t_A)) + v_belt·(t_B − t_A)` (overground `v_belt = 0`:
 //!   successive heel positions; on a treadmill the belt term plus the correction for the feet's
@@ -54,7 +54,7 @@ pub struct StepExtra {
     pub trial_speed_m_per_s: Option<f64>,
     /// Measured apex of the pelvis above its toe-off height during the flight, m (the check of
     /// eq. 3).
-    pub flight_height_peak_m: Option<f64>,
+    pub pelvis_apex_m: Option<f64>,
     /// How the step length was obtained (`heel`, `belt+heel`, `belt+cop`, `belt`,
     /// `half-stride`).
     pub step_length_method: String,
@@ -66,8 +66,8 @@ pub const EXTRA_COLUMNS: &[&str] = &[
     "setting",
     "stride_time_s",
     "trial_speed_m_per_s",
-    "flight_height_peak_m",
-    "step_length_method",
+    "pelvis_apex_m",
+    "sl_method",
 ];
 
 /// The per-step table of one trial.
@@ -112,18 +112,18 @@ pub fn source_label(trial: &Trial) -> String {
         .unwrap_or_else(|| trial.source.display().to_string())
 }
 
+/// The subject id from the file, else `<folder>_<trial>`: without subject data, gaitfit cannot
+/// tell whether two files of one folder are one person, and assumes they are not.
 fn subject_label(trial: &Trial) -> String {
     if let Some(id) = &trial.subject.id {
         if !id.trim().is_empty() {
             return id.trim().to_string();
         }
     }
-    trial
-        .source
-        .parent()
-        .and_then(|p| p.file_name())
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| trial.name.clone())
+    match trial.source.parent().and_then(|p| p.file_name()) {
+        Some(dir) => format!("{}_{}", dir.to_string_lossy(), trial.name),
+        None => trial.name.clone(),
+    }
 }
 
 /// The mean centre-of-pressure position of a contact in the belt frame along the forward axis.
@@ -193,7 +193,13 @@ pub fn steps_from_analysis(
     }
     // Subject data.
     let mut body_height = trial.subject.body_height_m;
-    let leg_length = trial.subject.leg_length_m;
+    let mut leg_length = trial.subject.leg_length_m;
+    if body_height.is_none() && leg_length.is_none() {
+        if let Some((l, how)) = kin.and_then(leg_from_hip_markers) {
+            leg_length = Some(l);
+            table.notes.push(how);
+        }
+    }
     if body_height.is_none() {
         if let Some(l) = leg_length {
             body_height = Some(l / LEG_LENGTH_PER_BODY_HEIGHT);
@@ -274,7 +280,7 @@ pub fn steps_from_analysis(
                 setting: setting_name.into(),
                 stride_time_s: Some(stride_t),
                 trial_speed_m_per_s: trial_speed,
-                flight_height_peak_m: None,
+                pelvis_apex_m: None,
                 step_length_method: "half-stride".into(),
             };
             let gait = row.stance_time_s.map(|st| {
@@ -367,7 +373,7 @@ pub fn steps_from_analysis(
                 setting: setting_name.into(),
                 stride_time_s: stride_t,
                 trial_speed_m_per_s: trial_speed,
-                flight_height_peak_m: peak,
+                pelvis_apex_m: peak,
                 step_length_method: method.into(),
             };
             rows.push((row, extra, gait));
@@ -422,7 +428,7 @@ pub fn steps_from_analysis(
             // A step whose events contradict the trial's gait keeps no phase time.
             row.flight_time_s = None;
             row.flight_height_m = None;
-            extra.flight_height_peak_m = None;
+            extra.pelvis_apex_m = None;
             row.double_support_time_s = None;
             row.double_support_pct_cycle = None;
         }
@@ -430,6 +436,42 @@ pub fn steps_from_analysis(
         table.extra.push(extra);
     }
     Ok(table)
+}
+
+/// Leg length estimated from the hip (greater trochanter or hip joint centre) markers while
+/// walking: the median height of the hip markers above the floor, the floor taken at 0 and
+/// checked by the lowest foot marker standing 0–12 cm above it. Walking flexes the knee a little,
+/// so this reads a centimetre or two under the standing value.
+fn leg_from_hip_markers(k: &Kinematics) -> Option<(f64, String)> {
+    let mut hips: Vec<f64> = Vec::new();
+    let mut lowest = f64::INFINITY;
+    let mut names = Vec::new();
+    for side in [Side::Left, Side::Right] {
+        let l = k.leg(side);
+        if let Some(h) = &l.hip {
+            hips.extend(h.iter().map(|p| k.up(p)).filter(|v| v.is_finite()));
+            names.push(l.names.hip.clone());
+        }
+        for m in [&l.heel, &l.toe, &l.meta].into_iter().flatten() {
+            lowest = lowest.min(m.iter().map(|p| k.up(p)).fold(f64::INFINITY, f64::min));
+        }
+    }
+    if hips.is_empty() || !(0.0..=0.12).contains(&lowest) {
+        return None;
+    }
+    hips.sort_by(f64::total_cmp);
+    let leg = hips[hips.len() / 2];
+    (0.5..1.3).contains(&leg).then(|| {
+        (
+            leg,
+            format!(
+                "leg length {leg:.3} m estimated as the median height of the hip markers ({}) \
+                 during the trial (no subject data in the file; the lowest foot marker is \
+                 {lowest:.3} m above the floor)",
+                names.join(", ")
+            ),
+        )
+    })
 }
 
 fn fill_mu(row: &mut StepRow, kin: Option<&Kinematics>, side: Side, hs: f64, to: Option<f64>) {
@@ -534,7 +576,7 @@ pub fn row_cells(r: &StepRow, x: &StepExtra) -> Vec<String> {
         x.setting.clone(),
         num(x.stride_time_s, 4),
         num(x.trial_speed_m_per_s, 4),
-        num(x.flight_height_peak_m, 5),
+        num(x.pelvis_apex_m, 5),
         x.step_length_method.clone(),
     ]);
     cells
