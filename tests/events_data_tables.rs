@@ -12,7 +12,11 @@ pub const TABLES: &[(&str, &[&str])] = &[
     ),
     (
         "walk_bmclab.csv",
-        &["bmclab/walk1.trc", "bmclab/walk2.trc", "bmclab/WinterTableA1.txt"],
+        &[
+            "bmclab/walk1.trc",
+            "bmclab/walk2.trc",
+            "bmclab/WinterTableA1.txt",
+        ],
     ),
     ("walk_schreiber2019.csv", &["schreiber2019"]),
 ];
@@ -36,8 +40,7 @@ fn regenerating_the_tables_reproduces_the_committed_ones() {
         cmd.arg("-o").arg(&out).assert().success();
         let fresh = std::fs::read_to_string(&out).unwrap();
         let committed =
-            std::fs::read_to_string(format!("{}/data/{name}", env!("CARGO_MANIFEST_DIR")))
-                .unwrap();
+            std::fs::read_to_string(format!("{}/data/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap();
         assert!(
             fresh == committed,
             "data/{name} differs from a fresh `gaitfit events` run; regenerate it with the command \
@@ -54,6 +57,10 @@ fn committed_tables_are_valid_trials_tables() {
             .join(name);
         let t = gaitfit::ingest::trials::read_trials(&p).unwrap();
         assert!(!t.is_empty(), "data/{name} is empty");
-        assert!(t.flagged.is_empty(), "data/{name}: flagged rows {:?}", t.flagged);
+        assert!(
+            t.flagged.is_empty(),
+            "data/{name}: flagged rows {:?}",
+            t.flagged
+        );
     }
 }

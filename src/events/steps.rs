@@ -120,10 +120,31 @@ fn subject_label(trial: &Trial) -> String {
             return id.trim().to_string();
         }
     }
-    match trial.source.parent().and_then(|p| p.file_name()) {
-        Some(dir) => format!("{}_{}", dir.to_string_lossy(), trial.name),
-        None => trial.name.clone(),
+    // Folders named after the kind of trial (Schreiber's `2014001/dynamic/`) are skipped: the
+    // subject's folder is the one above.
+    const GENERIC: &[&str] = &["dynamic", "static", "trials", "data", "c3d", "raw", "gait"];
+    let mut dir = trial.source.parent();
+    while let Some(d) = dir {
+        let name = d
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if GENERIC.contains(&name.to_ascii_lowercase().as_str()) {
+            dir = d.parent();
+            continue;
+        }
+        if name.is_empty() {
+            break;
+        }
+        // A folder per subject (`2014001/…`) names the subject; a folder of several people's
+        // files (`bmclab/`) does not, and each file is taken as its own subject.
+        return if name.chars().any(|c| c.is_ascii_digit()) {
+            name
+        } else {
+            format!("{name}_{}", trial.name)
+        };
     }
+    trial.name.clone()
 }
 
 /// The mean centre-of-pressure position of a contact in the belt frame along the forward axis.
