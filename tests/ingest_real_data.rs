@@ -403,3 +403,46 @@ fn t_min(v: &[f64], t: f64) -> f64 {
         .map(|x| (x - t).abs())
         .fold(f64::INFINITY, f64::min)
 }
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn every_shared_motion_file_reads() {
+    // Every file of the gait data sets that read_trial knows, read with default options.
+    let root = require("bmclab").parent().unwrap().to_path_buf();
+    let mut stack = vec![root.clone()];
+    let mut count = 0;
+    while let Some(dir) = stack.pop() {
+        for e in std::fs::read_dir(&dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                if !p.ends_with("nist-strd") {
+                    stack.push(p);
+                }
+                continue;
+            }
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            let known = ["trc", "mot", "forces", "c3d"]
+                .iter()
+                .any(|x| name.ends_with(&format!(".{x}")))
+                || name.ends_with("grf.txt")
+                || name == "WinterTableA1.txt"
+                || name == "wn35b.txt";
+            if !known {
+                continue;
+            }
+            let t = read_trial(&p, &ReadOptions::default())
+                .unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+            assert!(
+                t.markers.is_some()
+                    || !t.plates.is_empty()
+                    || name.ends_with("_ik.mot")
+                    || name == "ik_output_run.mot",
+                "{}: nothing read",
+                p.display()
+            );
+            count += 1;
+        }
+    }
+    // bmclab 11, hamner 20 GRF + 4 Run trc + 5 static, wbds 4, schreiber 12 + 6 + 12 ik.
+    assert_eq!(count, 74, "files read");
+}

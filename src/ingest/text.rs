@@ -132,6 +132,40 @@ pub(crate) fn numeric_row(
     Ok(())
 }
 
+/// Like [`numeric_row`] but an empty cell (or `NaN`) gives `NaN` and the row may end early:
+/// returns the number of cells present (at most `ncol`). `±inf` and text are errors.
+#[inline]
+pub(crate) fn sparse_row(
+    line: &[u8],
+    delim: u8,
+    ncol: usize,
+    out: &mut Vec<f64>,
+) -> Result<usize, RowError> {
+    out.clear();
+    let mut rest = line;
+    loop {
+        let end = memchr::memchr(delim, rest).unwrap_or(rest.len());
+        let t = trim_spaces(&rest[..end]);
+        if out.len() == ncol {
+            if !t.is_empty() {
+                return Err(RowError::Long);
+            }
+        } else if t.is_empty() {
+            out.push(f64::NAN);
+        } else {
+            match fast_float2::parse_partial::<f64, _>(t) {
+                Ok((v, n)) if n == t.len() && !v.is_infinite() => out.push(v),
+                _ => return Err(RowError::Bad(out.len())),
+            }
+        }
+        if end == rest.len() {
+            break;
+        }
+        rest = &rest[end + 1..];
+    }
+    Ok(out.len())
+}
+
 /// Why [`numeric_row`] failed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum RowError {

@@ -20,7 +20,7 @@
 //!   markers is an error (truncated or corrupt file), as is a file with fewer data rows than
 //!   `NumFrames`. Cortex writes extra (virtual, `V_…`) marker names beyond `NumMarkers` with
 //!   empty columns: those are read when present and dropped, with a note, when they hold no data.
-use super::text::{self, Num};
+use super::text;
 use super::types::{MarkerSet, Trial};
 use super::{finish, forces, hamner, mot, IngestError, ReadOptions};
 use std::path::Path;
@@ -221,63 +221,50 @@ pub fn parse_markers(
     let mut lines_of: Vec<usize> = Vec::with_capacity(num_frames);
     let mut pos: Vec<Vec<[f64; 3]>> = (0..nmk).map(|_| Vec::with_capacity(num_frames)).collect();
     let mut has_data = vec![false; nmk];
-    let mut row;
+    let mut vals: Vec<f64> = Vec::with_capacity(2 + 3 * nmk);
     for (ln, line) in it {
         if text::is_blank(line) {
             continue;
         }
-        let mut ncells = 0usize;
-        row = [f64::NAN; 3];
-        let mut frame_no = f64::NAN;
-        let mut t = f64::NAN;
-        for (c, cell) in text::cells(line, b'\t').enumerate() {
-            ncells = c + 1;
-            match c {
-                0 => frame_no = text::finite(cell, path, ln, "Frame#")?,
-                1 => t = text::finite(cell, path, ln, "Time")?,
-                _ => {
-                    let m = (c - 2) / 3;
-                    let k = (c - 2) % 3;
-                    if m >= nmk {
-                        if !text::trim(cell).is_empty() {
-                            return Err(IngestError::cell(
-                                path,
-                                ln,
-                                format!("column {}", c + 1),
-                                "data beyond the last named marker: the header is missing a \
-                                 marker name",
-                            ));
-                        }
-                        continue;
-                    }
-                    row[k] = match text::num(cell) {
-                        Num::Empty => f64::NAN,
-                        Num::Value(v) if v.is_nan() => f64::NAN,
-                        Num::Value(v) if v.is_finite() => v * scale,
-                        _ => {
-                            return Err(IngestError::cell(
-                                path,
-                                ln,
-                                format!("{} {}", names[m], ["X", "Y", "Z"][k]),
-                                format!(
-                                    "{:?} is not a finite number (leave the cell empty for a \
-                                     missing marker)",
-                                    text::text(cell)
-                                ),
-                            ))
-                        }
-                    };
-                    if k == 2 {
-                        let p = if row.iter().any(|v| v.is_nan()) {
-                            [f64::NAN; 3]
-                        } else {
-                            row
-                        };
-                        has_data[m] |= !p[0].is_nan();
-                        pos[m].push(p);
-                        row = [f64::NAN; 3];
-                    }
-                }
+        let ncells = match text::sparse_row(line, b'\t', 2 + 3 * nmk, &mut vals) {
+            Ok(n) => n,
+            Err(text::RowError::Bad(c)) => {
+                let cell = text::cells(line, b'\t')
+                    .nth(c)
+                    .map(text::text)
+                    .unwrap_or_default();
+                let column = match c {
+                    0 => "Frame#".to_string(),
+                    1 => "Time".to_string(),
+                    c => format!("{} {}", names[(c - 2) / 3], ["X", "Y", "Z"][(c - 2) % 3]),
+                };
+                return Err(IngestError::cell(
+                    path,
+                    ln,
+                    column,
+                    format!(
+                        "{cell:?} is not a finite number (leave the cell empty for a missing \
+                         marker)"
+                    ),
+                ));
+            }
+            Err(_) => {
+                return Err(IngestError::cell(
+                    path,
+                    ln,
+                    format!("column {}", 3 + 3 * nmk),
+                    "data beyond the last named marker: the header is missing a marker name",
+                ))
+            }
+        };
+        for (i, what) in [(0, "Frame#"), (1, "Time")] {
+            if vals.get(i).is_none_or(|v| v.is_nan()) && ncells >= need {
+                return Err(IngestError::cell(
+                    path,
+                    ln,
+                    what,
+                    "empty cell: give a number",
+                ));
             }
         }
         if ncells < need {
@@ -296,12 +283,19 @@ pub fn parse_markers(
                 ),
             ));
         }
-        // Markers whose columns the row does not reach (trailing empty cells left out).
-        for p in pos.iter_mut() {
-            if p.len() < time.len() + 1 {
-                p.push([f64::NAN; 3]);
-            }
+        // Markers whose columns the row does not reach (trailing empty cells left out) are
+        // missing in this frame.
+        for (m, traj) in pos.iter_mut().enumerate() {
+            let p = match vals.get(2 + 3 * m..5 + 3 * m) {
+                Some(&[x, y, z]) if !(x.is_nan() || y.is_nan() || z.is_nan()) => {
+                    has_data[m] = true;
+                    [x * scale, y * scale, z * scale]
+                }
+                _ => [f64::NAN; 3],
+            };
+            traj.push(p);
         }
+        let (frame_no, t) = (vals[0], vals[1]);
         time.push(t);
         frames.push(frame_no);
         lines_of.push(ln);
