@@ -2,11 +2,16 @@
 //!
 //! # Method
 //! [`nls`] minimises `½ Σ wᵢ (yᵢ − f(xᵢ, θ))²` with **argmin's trust-region method**
-//! (`argmin::solver::trustregion::TrustRegion` with the `Dogleg` subproblem) on the
-//! Gauss–Newton model: gradient `Jᵀr`, Hessian `JᵀJ` (plus a relative `1e-12` ridge that only
-//! keeps the Dogleg's inverse defined; it vanishes from the fixed point since the step is
-//! `−H⁻¹g` and `g = 0` there). A trust region on the Gauss–Newton model is what
-//! Levenberg–Marquardt approximates, so this behaves like MINPACK's `lmder`:
+//! (`argmin::solver::trustregion::TrustRegion` with the `Steihaug` truncated-CG subproblem) on
+//! the Gauss–Newton model: gradient `Jᵀr`, Hessian `JᵀJ` (plus a relative `1e-12` ridge that
+//! keeps it positive definite when a column vanishes, e.g. a parameter on a bound; it does not
+//! move the fixed point, where `g = 0`). A trust region on the Gauss–Newton model is what
+//! Levenberg–Marquardt approximates, so this behaves like MINPACK's `lmder`. Why not argmin's
+//! `Dogleg`: in argmin 0.11 its τ formulas cover only the Cauchy→Newton leg, so when the Cauchy
+//! point lies outside the radius it returns a zero step, the reduction ratio is 0/0 and the
+//! radius never shrinks (observed on BoxBOD and Rat43 from NIST start 1). Steihaug's CG is run
+//! with `epsilon = 1e-300` (its default 1e-9 is an *absolute* gradient cut-off that returns a
+//! zero step on small-scale problems) and at most `2p + 2` CG iterations.
 //! - **scaling** (Moré 1978): the solver works in `v = D·u`, where `D` holds the Jacobian column
 //!   norms (non-decreasing over restarts, 1 for a zero column), normalised so `‖v₀‖ = 1`; the
 //!   initial trust radius is 1 (a step as large as the start itself);
@@ -16,7 +21,11 @@
 //!   residuals, or an exactly zero residual;
 //! - **restarts**: after each run the scaling is recomputed at the new point and argmin is run
 //!   again, until a run converges without moving (≤ 1 accepted step) — this also resets a trust
-//!   radius that argmin's update rule could not grow back;
+//!   radius that argmin's update rule could not grow back (it doubles the radius only when
+//!   the step lies on the boundary to within 10ε *absolute*);
+//! - a rejected step whose reduction ratio is 0/0 (the step is below the resolution of `v`)
+//!   leaves argmin's radius unchanged; the wrapper detects the repeat and stops with
+//!   "step below machine precision" (converged);
 //! - **bounds** by MINUIT's smooth transforms (James & Roos 1975): `θ = lo + (hi − lo)(sin u + 1)/2`
 //!   for two-sided bounds, `θ = lo − 1 + √(u² + 1)` (lower) and `θ = hi + 1 − √(u² + 1)` (upper)
 //!   for one-sided ones. The optimiser never leaves the box; a parameter that ends within
@@ -346,7 +355,7 @@ impl Transform {
     }
 }
 
-/// Parameter `v`, Jacobian in `v`, weighted residuals.
+/// Parameter `v`, `JᵀJ` and `Jᵀr` in `v`.
 type JacobianCache = (DVector<f64>, DMatrix<f64>, DVector<f64>);
 
 /// The argmin problem: any [`Model`] plus data, in scaled unconstrained coordinates `v`.
@@ -386,48 +395,55 @@ impl<M: Model> Adapter<'_, M> {
         }
         Some(r)
     }
-    /// Jacobian of the weighted residuals with respect to u (`−√wᵢ ∂f/∂θ · dθ/du`).
-    fn jac_u(&self, u: &[f64]) -> Option<DMatrix<f64>> {
-        let theta = self.theta_of_u(u);
-        let (n, p) = (self.y.len(), theta.len());
-        let dt: Vec<f64> = u
-            .iter()
-            .zip(self.transforms)
-            .map(|(&u, t)| t.dtheta(u))
-            .collect();
-        let mut j = DMatrix::zeros(n, p);
-        let mut g = vec![0.0; p];
-        for i in 0..n {
-            self.model.gradient(self.x.row(i), &theta, &mut g);
-            for k in 0..p {
-                let v = -self.sw[i] * g[k] * dt[k];
-                if !v.is_finite() {
-                    return None;
-                }
-                j[(i, k)] = v;
-            }
-        }
-        Some(j)
-    }
-    fn jac_v(&self, v: &DVector<f64>) -> Result<(DMatrix<f64>, DVector<f64>), argmin::core::Error> {
-        if let Some((pv, j, r)) = self.cache.borrow().as_ref() {
+    /// Gauss–Newton pieces in v, `(JᵀJ, Jᵀr)`, accumulated row by row (no n×p Jacobian is
+    /// stored) and cached for the `gradient`/`hessian` pair at the same point.
+    fn normal_v(
+        &self,
+        v: &DVector<f64>,
+    ) -> Result<(DMatrix<f64>, DVector<f64>), argmin::core::Error> {
+        if let Some((pv, h, g)) = self.cache.borrow().as_ref() {
             if pv == v {
-                return Ok((j.clone(), r.clone()));
+                return Ok((h.clone(), g.clone()));
             }
         }
         let u = self.u_of_v(v);
         let theta = self.theta_of_u(&u);
-        let mut j = self.jac_u(&u).ok_or_else(|| {
-            argmin::core::Error::msg(format!("non-finite Jacobian at θ = {theta:?}"))
-        })?;
-        let r = self.residuals(&theta).ok_or_else(|| {
-            argmin::core::Error::msg(format!("non-finite residuals at θ = {theta:?}"))
-        })?;
-        for (k, d) in self.d.iter().enumerate() {
-            j.column_mut(k).scale_mut(1.0 / d);
+        let p = theta.len();
+        // dr/dv_k = −√w ∂f/∂θ_k · dθ_k/du_k / d_k
+        let chain: Vec<f64> = (0..p)
+            .map(|k| self.transforms[k].dtheta(u[k]) / self.d[k])
+            .collect();
+        let mut h = DMatrix::<f64>::zeros(p, p);
+        let mut g = DVector::<f64>::zeros(p);
+        let mut df = vec![0.0; p];
+        let mut jr = vec![0.0; p];
+        for i in 0..self.y.len() {
+            let xi = self.x.row(i);
+            let f = self.model.value(xi, &theta);
+            self.model.gradient(xi, &theta, &mut df);
+            let r = self.sw[i] * (self.y[i] - f);
+            for k in 0..p {
+                jr[k] = -self.sw[i] * df[k] * chain[k];
+            }
+            if !r.is_finite() || jr.iter().any(|v| !v.is_finite()) {
+                return Err(argmin::core::Error::msg(format!(
+                    "non-finite residual or gradient at row {i}, θ = {theta:?}"
+                )));
+            }
+            for a in 0..p {
+                g[a] += jr[a] * r;
+                for b in 0..=a {
+                    h[(a, b)] += jr[a] * jr[b];
+                }
+            }
         }
-        *self.cache.borrow_mut() = Some((v.clone(), j.clone(), r.clone()));
-        Ok((j, r))
+        for a in 0..p {
+            for b in 0..a {
+                h[(b, a)] = h[(a, b)];
+            }
+        }
+        *self.cache.borrow_mut() = Some((v.clone(), h.clone(), g.clone()));
+        Ok((h, g))
     }
 }
 
@@ -436,10 +452,16 @@ impl<M: Model> CostFunction for Adapter<'_, M> {
     type Output = f64;
     fn cost(&self, v: &DVector<f64>) -> Result<f64, argmin::core::Error> {
         let theta = self.theta_of_u(&self.u_of_v(v));
+        let mut ss = 0.0;
+        for i in 0..self.y.len() {
+            let r = self.sw[i] * (self.y[i] - self.model.value(self.x.row(i), &theta));
+            ss += r * r;
+        }
         // A non-finite trial point is simply a very bad one: the trust region shrinks.
-        Ok(match self.residuals(&theta) {
-            Some(r) => 0.5 * r.norm_squared(),
-            None => f64::INFINITY,
+        Ok(if ss.is_finite() {
+            0.5 * ss
+        } else {
+            f64::INFINITY
         })
     }
 }
@@ -448,8 +470,7 @@ impl<M: Model> Gradient for Adapter<'_, M> {
     type Param = DVector<f64>;
     type Gradient = DVector<f64>;
     fn gradient(&self, v: &DVector<f64>) -> Result<DVector<f64>, argmin::core::Error> {
-        let (j, r) = self.jac_v(v)?;
-        Ok(j.tr_mul(&r))
+        Ok(self.normal_v(v)?.1)
     }
 }
 
@@ -457,10 +478,10 @@ impl<M: Model> Hessian for Adapter<'_, M> {
     type Param = DVector<f64>;
     type Hessian = DMatrix<f64>;
     fn hessian(&self, v: &DVector<f64>) -> Result<DMatrix<f64>, argmin::core::Error> {
-        let (j, _) = self.jac_v(v)?;
-        let mut h = j.tr_mul(&j);
-        // Tiny ridge so the Dogleg's inverse exists when a column vanishes (parameter on a
-        // bound); it does not move the fixed point (the step is −H⁻¹g with g = 0 there).
+        let mut h = self.normal_v(v)?.0;
+        // Tiny ridge: keeps H positive definite when a column vanishes (parameter on a bound),
+        // so Steihaug's CG never meets zero curvature (its negative-curvature branch sorts NaN
+        // model values with `partial_cmp().unwrap()`). It does not move the fixed point g = 0.
         let ridge = 1e-12 * h.diagonal().max().max(f64::MIN_POSITIVE);
         for k in 0..h.nrows() {
             h[(k, k)] += ridge;
@@ -492,7 +513,7 @@ where
     S: Solver<O, TrState>,
 {
     fn name(&self) -> &str {
-        "Trust region (Dogleg, Gauss-Newton Hessian) with MINPACK stopping tests"
+        "Trust region (Steihaug, Gauss-Newton Hessian) with MINPACK stopping tests"
     }
     fn init(
         &mut self,
@@ -737,12 +758,17 @@ pub fn nls<M: Model>(
     while runs <= opts.max_restarts && iterations < opts.max_iter {
         runs += 1;
         // Moré scaling: non-decreasing column norms of the Jacobian in u.
-        let ju = probe.jac_u(&u).ok_or_else(|| FitError::Optimizer {
-            relation: name.clone(),
-            message: format!("non-finite Jacobian at θ = {:?}", probe.theta_of_u(&u)),
-        })?;
+        // Column norms of J in u are the square roots of diag(JᵀJ) with unit scaling.
+        probe.d = vec![1.0; p];
+        *probe.cache.borrow_mut() = None;
+        let (jtj, _) = probe
+            .normal_v(&DVector::from_column_slice(&u))
+            .map_err(|e| FitError::Optimizer {
+                relation: name.clone(),
+                message: e.to_string(),
+            })?;
         for (k, dk) in d_max.iter_mut().enumerate() {
-            *dk = dk.max(ju.column(k).norm());
+            *dk = dk.max(jtj[(k, k)].sqrt());
         }
         let mut d: Vec<f64> = d_max
             .iter()
