@@ -28,6 +28,8 @@
 //!    length 70.69 and leg length 73.90 match Winter's data in cm).
 //!
 //! With these, Theorems 1–5 hold to rounding (property tests to 1e-9).
+pub mod angles;
+pub mod compare;
 pub mod figure;
 pub mod geometry;
 pub mod mu;

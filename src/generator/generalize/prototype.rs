@@ -21,22 +21,27 @@
 //!   no reference).
 //! - The stance heel's floor point x₀ and the floor height y₀ are those that put the model's
 //!   stance ankle (rolling over fixed heel, ball and toe pivots with the measured angles) closest
-//!   to the measured ankle over the whole stance (least squares). A real heel rolls ≈ 2.5 cm
+//!   to the measured ankle over the whole stance (least squares). A real heel rolls ≈ 2–3 cm
 //!   forward during the heel rocker (Winter's heel marker does); a point pivot cannot, and this
-//!   splits the difference between heel strike and foot flat.
+//!   splits the difference between heel strike and foot flat. (Placing the heel at heel strike,
+//!   or weighting the error along the leg, made the Schreiber comparison's model floor worse.)
 //! - sl* is half the heel marker's displacement between the two heel strikes; the pelvis travel
 //!   over the step is corrected linearly to exactly sl* (otherwise repeated steps would drift).
 //! - FGM: the foot angle first within [`FLAT_FOOT_TOLERANCE_RAD`] of flat after heel strike;
 //!   MOM: the ball marker's last rise [`BALL_LIFT_M`] above its flat height before toe off;
 //!   TOM: toe off (as the swing foot's time in the step).
-//! - μ* are read off the data (μ₂* = F₁(0), μ₃* = −F₂(end), μ₄* = M(end), μ₁* = the marker
-//!   knee flexion at heel strike); thigh and shin (marker means, the thigh from the pelvis
-//!   centre) are scaled together so the model leg bends by μ₁* at heel strike (skin artifact
-//!   makes marker-mean legs ≈ 1 cm too short to reach the hip there); the raw W is made
-//!   consistent by φ₁
+//! - Thigh (from the pelvis centre) and shin keep their marker-mean ratio and are scaled so the
+//!   model leg, from H(0) to the model's heel-strike ankle, bends exactly as the measured knee
+//!   does at heel strike (μ₁*). A leg near full extension turns a centimetre of skin artifact
+//!   into 10–20° of knee flexion, so raw marker means will not do; with them Winter's leg is
+//!   ≈ 1 cm too short to reach the hip at heel strike. (A least-squares scale over the whole
+//!   stride left heel strike out of reach and, through eq. 27's pinning, lowered the hip over
+//!   the whole step: worse.)
+//! - μ* are read off the data (μ₂* = F₁(0), μ₃* = −F₂(end), μ₄* = M(end), μ₁* = the measured
+//!   knee flexion at heel strike), and the raw W is made consistent by φ₁
 //!   (which pins the hip heights, blends F₃ onto the heel-strike angle and maps A onto the
 //!   model's toe-off and heel-strike ankles); [`PrototypeReport`] says how far each end moved.
-use super::geometry::{foot_on_pivot, hip_ankle_distance, Pivot};
+use super::geometry::{foot_on_pivot, hip_ankle_distance, knee_flexion_for_distance, Pivot};
 use super::mu::MuFunctions;
 use super::phi::phi;
 use super::walk_data::{Anthropometry, Moments, TimedSequence, WalkData};
@@ -369,6 +374,7 @@ pub fn build_prototype(
         let f = if t <= fgm_t { f.max(0.0) } else { f.min(0.0) };
         foot_on_pivot(&body, pivot, f, meta(t).max(0.0)).ankle
     };
+    // Least squares over the whole stance (closed form: the mean residual).
     let stance_grid = grid(ts, hs0, to);
     let k = stance_grid.len() as f64;
     let (mut x0, mut y0) = (0.0, 0.0);
@@ -444,19 +450,13 @@ pub fn build_prototype(
             .collect(),
     )?;
 
-    // μ* from the data. μ₁* is the measured (marker) knee flexion at heel strike; the leg's
-    // two segments are scaled together so that the model leg, from H(0) to the model's
-    // heel-strike ankle, bends exactly that much. With the bare marker means (skin artifact moves
-    // Winter's knee–ankle distance by ±1.5 cm) the model leg is ≈ 1 cm too short to reach the
-    // hip at heel strike and would be straight there, where the real knee is flexed ≈ 3°.
+    // Leg lengths: thigh and shin keep their marker-mean ratio, scaled so the model leg bends
+    // at heel strike exactly as the measured knee (thigh from the pelvis centre) does.
     let mu2 = foot1.first()[0];
-    let mu3 = -foot2.last()[0];
-    let mu4 = meta_seq.last()[0];
-    let (hh, kk, aa) = (at(&leg.hip, hs0), at(&leg.knee, hs0), at(&leg.ankle, hs0));
-    let mu1 = (angle(hh, kk) - angle(kk, aa)).abs();
+    let (hh, kk, aa) = (pelvis(hs0), at(&leg.knee, hs0), at(&leg.ankle, hs0));
+    let mu1_measured = (kk[0] - hh[0]).atan2(hh[1] - kk[1]) - (aa[0] - kk[0]).atan2(kk[1] - aa[1]);
     let a0 = foot_on_pivot(&body, Pivot::Heel(0.0), mu2, 0.0).ankle;
-    let d0 = dist(hip.first(), a0);
-    let leg_scale = d0 / hip_ankle_distance(&body, mu1);
+    let leg_scale = dist(hip.first(), a0) / hip_ankle_distance(&body, mu1_measured);
     let body = Anthropometry::new(
         leg_scale * body.thigh(),
         leg_scale * body.shin(),
@@ -465,6 +465,12 @@ pub fn build_prototype(
         body.ankle_to_n(),
         body.ball_to_toe(),
     )?;
+    // μ* from the data: μ₂* = F₁(0), μ₃* = −F₂(end), μ₄* = M(end); μ₁* = the model leg's knee
+    // flexion at heel strike — the measured one, by the scaling above.
+    let mu3 = -foot2.last()[0];
+    let mu4 = meta_seq.last()[0];
+    let a0 = foot_on_pivot(&body, Pivot::Heel(0.0), mu2, 0.0).ankle;
+    let mu1 = knee_flexion_for_distance(&body, dist(hip.first(), a0)).unwrap_or(0.0);
     let mu_star = [mu1, mu2, mu3, mu4];
     let raw = WalkData::new(
         body, sl, sl, moments, hip, foot1, foot2, foot3, meta_seq, ankle,
@@ -838,4 +844,51 @@ pub fn winter_prototype(
         },
         report,
     ))
+}
+
+/// The pelvis-centre estimate the builder uses for H, at time `t` (see [`build_prototype`]):
+/// the mean of this hip and the mirrored other hip (this one half a stride away, one step
+/// `sl` away).
+pub(crate) fn pelvis_at(leg: &SagittalLeg, ev: &StrideEvents, sl: f64, t: f64) -> [f64; 2] {
+    let tau = 0.5 * (ev.next_heel_strike - ev.heel_strike);
+    let a = sample(&leg.time_s, &leg.hip, t);
+    let b = if t + tau <= ev.next_heel_strike {
+        let q = sample(&leg.time_s, &leg.hip, t + tau);
+        [q[0] - sl, q[1]]
+    } else {
+        let q = sample(&leg.time_s, &leg.hip, t - tau);
+        [q[0] + sl, q[1]]
+    };
+    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])]
+}
+
+/// The heel→ball marker line's angle in the flat-foot window (what foot angles are measured
+/// from), rad.
+pub(crate) fn flat_foot_line(leg: &SagittalLeg, ev: &StrideEvents) -> f64 {
+    let stance = ev.toe_off - ev.heel_strike;
+    let v: Vec<f64> = leg
+        .time_s
+        .iter()
+        .copied()
+        .filter(|&t| {
+            t >= ev.heel_strike + FLAT_WINDOW.0 * stance
+                && t <= ev.heel_strike + FLAT_WINDOW.1 * stance
+        })
+        .map(|t| {
+            angle(
+                sample(&leg.time_s, &leg.heel, t),
+                sample(&leg.time_s, &leg.ball, t),
+            )
+        })
+        .collect();
+    if v.is_empty() {
+        0.0
+    } else {
+        median(v)
+    }
+}
+
+/// Linear interpolation of a landmark at time `t` (clamped).
+pub(crate) fn landmark_at(leg: &SagittalLeg, v: &[[f64; 2]], t: f64) -> [f64; 2] {
+    sample(&leg.time_s, v, t)
 }
