@@ -19,6 +19,7 @@ pub const TABLES: &[(&str, &[&str])] = &[
         ],
     ),
     ("walk_schreiber2019.csv", &["schreiber2019"]),
+    ("walk_wbds.csv", &["wbds"]),
 ];
 
 #[test]

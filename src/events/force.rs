@@ -512,7 +512,9 @@ fn resolve_cross_belt(contacts: &mut [Contact], notes: &mut Vec<String>) {
             let (a, b) = (&contacts[i], &contacts[i + 1]);
             let overlap = (a.span_s.1.min(b.span_s.1) - b.span_s.0.max(a.span_s.0)).max(0.0);
             let shorter = (a.span_s.1 - a.span_s.0).min(b.span_s.1 - b.span_s.0);
-            a.side != b.side && overlap > 0.5 * shorter
+            // Contacts cut by the record have unknown durations: the rule does not apply.
+            let whole = |c: &Contact| c.on_s.is_some() && c.off_s.is_some();
+            a.side != b.side && whole(a) && whole(b) && overlap > 0.5 * shorter
         } else {
             false
         };
