@@ -1,11 +1,159 @@
-//! `gaitfit fit`.
+//! `gaitfit fit`: refit the published relations on trials tables → `fits/` and `reports/`.
+use crate::export::coeffs::write_fit_files;
+use crate::fit::pipeline::{fit_all, load_tables, FitOptions};
+use crate::relations::{by_id, registry, Relation};
+use anyhow::Context;
+use std::io::IsTerminal;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `gaitfit fit`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(
+    about = "Refit the published gait relations on trials tables and write fits/ and reports/",
+    long_about = "Refit the published gait relations (running 1996 eqs. 2, 4–5; walking 1989 eq. 1 \
+and the t_ds formula) on per-step trials tables, with full statistics.\n\n\
+Input: CSV trials tables with a unit in every numeric header (see data/README.md), e.g. \
+subject,gait,speed_m_per_s,step_length_m,step_freq_steps_per_min,flight_time_s,body_height_m. \
+Rows lacking what a relation needs, or whose speed, step length and step frequency disagree by \
+more than 2 %, are rejected and reported, never silently used.\n\n\
+Output: fits/<id>.json and fits/<id>.toml per relation (coefficients with standard errors, 95 % \
+intervals, t-tests against the published values, r², rmse, AIC/BIC, leave-one-out and \
+leave-one-subject-out errors, the published coefficients' fit on the same rows, data hash), and \
+reports/ (per relation: data with refit curve, 95 % band and published curve; residuals vs \
+fitted; normal Q–Q; summary.md). Files are replaced atomically; a relation that fails to fit \
+leaves its existing fits/ files untouched and makes the command exit 1.\n\n\
+Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf.",
+    after_help = "Examples:\n  gaitfit fit                                   # data/*.csv, all relations\n  \
+gaitfit fit --data my_trials.csv --relation run-sl-v\n  \
+gaitfit fit --robust --bootstrap 1000 --seed 7"
+)]
+pub struct Args {
+    /// Trials tables (CSV) to fit on, fitted together. Default: every data/*.csv.
+    #[arg(long = "data", value_name = "FILE", num_args = 1..)]
+    pub data: Vec<PathBuf>,
+    /// Relation id(s) to fit. Default: all (relations whose gait has no rows are skipped).
+    #[arg(long = "relation", value_name = "ID", num_args = 1..)]
+    pub relation: Vec<String>,
+    /// Folder for fits/<id>.json and .toml.
+    #[arg(long, value_name = "DIR", default_value = "fits")]
+    pub fits: PathBuf,
+    /// Folder for plots and summary.md.
+    #[arg(long, value_name = "DIR", default_value = "reports")]
+    pub reports: PathBuf,
+    /// Also fit a Huber robust M-estimate (IRLS, k = 1.345) and report it beside least squares.
+    #[arg(long)]
+    pub robust: bool,
+    /// Weighted least squares with weights (inverse variances, > 0) from this column.
+    #[arg(long, value_name = "COLUMN")]
+    pub weights: Option<String>,
+    /// Bootstrap replicates, resampling subjects, for percentile 95 % intervals (0 = none).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub bootstrap: usize,
+    /// Seed of the bootstrap.
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    pub seed: u64,
+    /// Do not write reports/ (plots and summary).
+    #[arg(long)]
+    pub no_report: bool,
+}
+
+fn default_data() -> anyhow::Result<Vec<PathBuf>> {
+    let dir = PathBuf::from("data");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .with_context(|| {
+            "no --data given and no data/ folder here: run from the repository root or pass \
+             --data FILE"
+                .to_string()
+        })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+        .collect();
+    v.sort();
+    if v.is_empty() {
+        anyhow::bail!("no data/*.csv trials tables found; pass --data FILE");
+    }
+    Ok(v)
+}
 
 /// Runs `gaitfit fit`.
-pub fn run(_args: &Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("gaitfit fit: not implemented yet")
+pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
+    let paths = if args.data.is_empty() {
+        default_data()?
+    } else {
+        args.data.clone()
+    };
+    let relations: Vec<Box<dyn Relation>> = if args.relation.is_empty() {
+        registry()
+    } else {
+        args.relation
+            .iter()
+            .map(|id| by_id(id))
+            .collect::<Result<_, _>>()?
+    };
+    let tables = load_tables(&paths, None)?;
+    let opts = FitOptions {
+        robust: args.robust,
+        weights: args.weights.clone(),
+        bootstrap: args.bootstrap,
+        seed: args.seed,
+    };
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(relations.len() as u64);
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} fitting {msg}")
+        {
+            b.set_style(style);
+        }
+        Some(b)
+    } else {
+        None
+    };
+    let run = fit_all(&relations, &tables, &opts, args.relation.is_empty(), |id| {
+        if let Some(b) = &bar {
+            b.set_message(id.to_string());
+            b.inc(1);
+        }
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    for o in &run.outcomes {
+        write_fit_files(&args.fits, &o.record)?;
+        let r = &o.record;
+        let unit = r
+            .units
+            .get(o.refit.response().symbol)
+            .cloned()
+            .unwrap_or_default();
+        println!(
+            "{}: n = {}, r² = {:.4} (published {:.4}), rmse = {:.4} {} → {}",
+            r.relation,
+            r.n,
+            r.r2,
+            r.published_fit.r2,
+            r.rmse,
+            unit,
+            args.fits.join(format!("{}.json", r.relation)).display()
+        );
+    }
+    for (id, why) in &run.skipped {
+        println!("{id}: skipped ({why})");
+    }
+    for (id, why) in &run.failures {
+        eprintln!("gaitfit: {id}: not fitted: {why} (existing fits left untouched)");
+    }
+    if !args.no_report && !run.outcomes.is_empty() {
+        let files = crate::report::write_report(&args.reports, &run.outcomes, &run.failures)?;
+        println!(
+            "reports: {} files in {}",
+            files.len(),
+            args.reports.display()
+        );
+    }
+    Ok(if run.failures.is_empty() && !run.outcomes.is_empty() {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    })
 }

@@ -1,5 +1,6 @@
 //! Writers: coefficient tables (JSON, TOML, Rust, CSV) and motion files (BVH, CSV, TRC).
 pub mod bvh;
+pub mod coeffs;
 pub mod motion;
 pub mod motion_csv;
 pub mod trc;

@@ -221,6 +221,8 @@ pub struct TrialsTable {
     pub is_flagged: Vec<bool>,
     /// Columns present in the file that gaitfit does not use.
     pub ignored_columns: Vec<String>,
+    /// Those columns' values where numeric (`NaN` elsewhere), e.g. for `--weights <column>`.
+    pub extra: Vec<(String, Vec<f64>)>,
 }
 
 impl TrialsTable {
@@ -347,6 +349,21 @@ impl TrialsTable {
                 self.ignored_columns.push(c.clone());
             }
         }
+        let mut extra = std::mem::take(&mut self.extra);
+        for (name, col) in &mut extra {
+            match other.extra.iter().find(|(n, _)| n == name) {
+                Some((_, o)) => col.extend_from_slice(o),
+                None => col.extend(std::iter::repeat_n(f64::NAN, n1)),
+            }
+        }
+        for (name, o) in &other.extra {
+            if !extra.iter().any(|(n, _)| n == name) {
+                let mut col = vec![f64::NAN; n0];
+                col.extend_from_slice(o);
+                extra.push((name.clone(), col));
+            }
+        }
+        self.extra = extra;
     }
 
     /// Fills derived quantities and flags inconsistent rows (see the module docs).
@@ -549,6 +566,7 @@ impl Builder {
             flagged: Vec::new(),
             is_flagged: vec![false; n],
             ignored_columns: ignored,
+            extra: Vec::new(),
         }
     }
 }
@@ -671,6 +689,10 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
         }
     }
     let mut b = Builder::default();
+    let extra_idx: Vec<usize> = (0..roles.len())
+        .filter(|&k| matches!(roles[k], Role::Ignored))
+        .collect();
+    let mut extra: Vec<Vec<f64>> = vec![Vec::new(); extra_idx.len()];
     let mut rec = csv::ByteRecord::new();
     let mut row = 0usize;
     loop {
@@ -736,6 +758,13 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
                 Role::Ignored => {}
             }
         }
+        for (e, &k) in extra.iter_mut().zip(&extra_idx) {
+            let v = std::str::from_utf8(rec[k].trim_ascii())
+                .ok()
+                .and_then(|s| s.parse::<f64>().ok())
+                .unwrap_or(f64::NAN);
+            e.push(v);
+        }
         if subject.is_empty() {
             return Err(IngestError::cell(
                 path,
@@ -763,7 +792,8 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
             "no data rows after the header",
         ));
     }
-    let mut t = b.finish(path.to_path_buf(), sha, ignored);
+    let mut t = b.finish(path.to_path_buf(), sha, ignored.clone());
+    t.extra = ignored.into_iter().zip(extra).collect();
     // Columns the file has but all of whose cells are empty are still "present".
     for (k, p) in present.iter().enumerate() {
         if *p && t.columns[k].is_none() {
