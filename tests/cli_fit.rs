@@ -12,15 +12,34 @@ fn gaitfit(dir: &Path) -> Command {
 
 fn setup() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let rows = synthetic_rows(&SyntheticSpec { rows: 800, subjects: 6, seed: 5, ..Default::default() });
+    let rows = synthetic_rows(&SyntheticSpec {
+        rows: 800,
+        subjects: 6,
+        seed: 5,
+        ..Default::default()
+    });
     write_trials(&dir.path().join("data/trials.csv"), &rows).unwrap();
     dir
 }
 
 const REQUIRED: &[&str] = &[
-    "relation", "equation", "units", "n", "coefficients", "r2", "adj_r2", "rmse",
-    "residual_mean_square", "aic", "bic", "loo_rmse", "loso_rmse", "published_fit",
-    "valid_range", "data", "gaitfit_version",
+    "relation",
+    "equation",
+    "units",
+    "n",
+    "coefficients",
+    "r2",
+    "adj_r2",
+    "rmse",
+    "residual_mean_square",
+    "aic",
+    "bic",
+    "loo_rmse",
+    "loso_rmse",
+    "published_fit",
+    "valid_range",
+    "data",
+    "gaitfit_version",
 ];
 
 #[test]
@@ -43,15 +62,30 @@ fn help_explains_every_subcommand() {
 fn fit_check_export_round_trip() {
     let dir = setup();
     let d = dir.path();
-    let out = gaitfit(d).args(["fit", "--robust", "--bootstrap", "20", "--seed", "4"]).output().unwrap();
+    let out = gaitfit(d)
+        .args(["fit", "--robust", "--bootstrap", "20", "--seed", "4"])
+        .output()
+        .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // Piped: no progress bar.
     assert!(!String::from_utf8_lossy(&out.stderr).contains("fitting"));
-    for id in ["run-sl-v", "run-tflight-sf", "run-tflight-sf-continuous", "walk-sl-sf", "walk-tds-sf"] {
+    for id in [
+        "run-sl-v",
+        "run-tflight-sf",
+        "run-tflight-sf-continuous",
+        "walk-sl-sf",
+        "walk-tds-sf",
+    ] {
         assert!(stdout.contains(&format!("{id}: n = ")), "{stdout}");
-        let v: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(d.join(format!("fits/{id}.json"))).unwrap()).unwrap();
+        let v: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(d.join(format!("fits/{id}.json"))).unwrap(),
+        )
+        .unwrap();
         for k in REQUIRED {
             assert!(v.get(k).is_some(), "{id}: key {k} missing");
         }
@@ -62,12 +96,23 @@ fn fit_check_export_round_trip() {
         }
         assert_eq!(v["data"]["path"], "data/trials.csv");
         assert_eq!(v["data"]["sha256"].as_str().unwrap().len(), 64);
-        let t: toml::Value = toml::from_str(&std::fs::read_to_string(d.join(format!("fits/{id}.toml"))).unwrap()).unwrap();
-        assert_eq!(t["n"].as_integer().unwrap() as u64, v["n"].as_u64().unwrap());
+        let t: toml::Value =
+            toml::from_str(&std::fs::read_to_string(d.join(format!("fits/{id}.toml"))).unwrap())
+                .unwrap();
+        assert_eq!(
+            t["n"].as_integer().unwrap() as u64,
+            v["n"].as_u64().unwrap()
+        );
         for suffix in ["", "-residuals", "-qq"] {
             for ext in ["svg", "png"] {
                 let p = d.join(format!("reports/{id}{suffix}.{ext}"));
-                assert!(std::fs::metadata(&p).map(|m| m.len() > 1000).unwrap_or(false), "{}", p.display());
+                assert!(
+                    std::fs::metadata(&p)
+                        .map(|m| m.len() > 1000)
+                        .unwrap_or(false),
+                    "{}",
+                    p.display()
+                );
             }
         }
     }
@@ -75,29 +120,57 @@ fn fit_check_export_round_trip() {
     assert!(summary.contains("uncentred") && summary.contains("jump_at_k1"));
 
     // The r² gate.
-    let ok = gaitfit(d).args(["check", "--fits", "fits", "--min-r2", "0.5"]).output().unwrap();
+    let ok = gaitfit(d)
+        .args(["check", "--fits", "fits", "--min-r2", "0.5"])
+        .output()
+        .unwrap();
     assert!(ok.status.success());
-    let bad = gaitfit(d).args(["check", "--fits", "fits", "--min-r2", "0.95"]).output().unwrap();
+    let bad = gaitfit(d)
+        .args(["check", "--fits", "fits", "--min-r2", "0.95"])
+        .output()
+        .unwrap();
     assert_eq!(bad.status.code(), Some(1));
     let err = String::from_utf8_lossy(&bad.stderr);
-    assert!(err.contains("run-tflight-sf") && err.contains("walk-tds-sf") && !err.contains("walk-sl-sf"), "{err}");
+    assert!(
+        err.contains("run-tflight-sf")
+            && err.contains("walk-tds-sf")
+            && !err.contains("walk-sl-sf"),
+        "{err}"
+    );
 
     // Exports.
-    let csv = gaitfit(d).args(["export", "--format", "csv"]).output().unwrap();
+    let csv = gaitfit(d)
+        .args(["export", "--format", "csv"])
+        .output()
+        .unwrap();
     assert!(csv.status.success());
     let csv = String::from_utf8_lossy(&csv.stdout).to_string();
-    assert!(csv.lines().next().unwrap().starts_with("relation,coefficient,unit,value"));
+    assert!(csv
+        .lines()
+        .next()
+        .unwrap()
+        .starts_with("relation,coefficient,unit,value"));
     assert!(csv.contains("walk-sl-sf,k,"));
-    let json = gaitfit(d).args(["export", "--format", "json"]).output().unwrap();
+    let json = gaitfit(d)
+        .args(["export", "--format", "json"])
+        .output()
+        .unwrap();
     let arr: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
     assert_eq!(arr.as_array().unwrap().len(), 5);
-    let tml = gaitfit(d).args(["export", "--format", "toml", "-o", "out/all.toml"]).output().unwrap();
+    let tml = gaitfit(d)
+        .args(["export", "--format", "toml", "-o", "out/all.toml"])
+        .output()
+        .unwrap();
     assert!(tml.status.success());
-    let t: toml::Value = toml::from_str(&std::fs::read_to_string(d.join("out/all.toml")).unwrap()).unwrap();
+    let t: toml::Value =
+        toml::from_str(&std::fs::read_to_string(d.join("out/all.toml")).unwrap()).unwrap();
     assert!(t.get("walk-sl-sf").is_some());
 
     // Rust: a self-contained module that compiles on its own.
-    let rs = gaitfit(d).args(["export", "--format", "rust", "-o", "coeffs.rs"]).output().unwrap();
+    let rs = gaitfit(d)
+        .args(["export", "--format", "rust", "-o", "coeffs.rs"])
+        .output()
+        .unwrap();
     assert!(rs.status.success());
     let src = std::fs::read_to_string(d.join("coeffs.rs")).unwrap();
     assert!(src.contains("pub const WALK_SL_SF_K: f64 ="));
@@ -105,10 +178,28 @@ fn fit_check_export_round_trip() {
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
     let out = std::process::Command::new(rustc)
         .current_dir(d)
-        .args(["--crate-type", "lib", "--edition", "2021", "-D", "warnings", "-D", "missing_docs", "--emit", "metadata", "-o", "coeffs.rmeta", "coeffs.rs"])
+        .args([
+            "--crate-type",
+            "lib",
+            "--edition",
+            "2021",
+            "-D",
+            "warnings",
+            "-D",
+            "missing_docs",
+            "--emit",
+            "metadata",
+            "-o",
+            "coeffs.rmeta",
+            "coeffs.rs",
+        ])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }
 
 #[test]
@@ -120,14 +211,27 @@ fn a_failed_fit_leaves_existing_fits_untouched_and_exits_1() {
     std::fs::create_dir_all(d.join("data")).unwrap();
     let mut csv = String::from("subject,gait,step_freq_hz,step_length_m,body_height_m\n");
     for i in 0..10 {
-        csv.push_str(&format!("S{},walk,{},0.7,1.8\n", i % 3, 1.7 + 0.02 * i as f64));
+        csv.push_str(&format!(
+            "S{},walk,{},0.7,1.8\n",
+            i % 3,
+            1.7 + 0.02 * i as f64
+        ));
     }
     std::fs::write(d.join("data/t.csv"), csv).unwrap();
-    let out = gaitfit(d).args(["fit", "--relation", "walk-tds-sf"]).output().unwrap();
+    let out = gaitfit(d)
+        .args(["fit", "--relation", "walk-tds-sf"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("walk-tds-sf") && err.contains("missing double_support_pct_cycle"), "{err}");
-    assert_eq!(std::fs::read_to_string(d.join("fits/walk-tds-sf.json")).unwrap(), "OLD");
+    assert!(
+        err.contains("walk-tds-sf") && err.contains("missing double_support_pct_cycle"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.join("fits/walk-tds-sf.json")).unwrap(),
+        "OLD"
+    );
     let leftovers = std::fs::read_dir(d.join("fits")).unwrap().count();
     assert_eq!(leftovers, 1);
 }
@@ -137,13 +241,28 @@ fn bad_data_and_bad_relation_are_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("t.csv"), "subject,gait,step_length_m\nA,walk,80\n").unwrap();
-    let out = gaitfit(d).args(["fit", "--data", "t.csv"]).output().unwrap();
+    let out = gaitfit(d)
+        .args(["fit", "--data", "t.csv"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("t.csv: row 1, column step_length_m") && err.contains("step_length_cm"), "{err}");
-    let out = gaitfit(d).args(["fit", "--data", "t.csv", "--relation", "run-sl-x"]).output().unwrap();
+    assert!(
+        err.contains("t.csv: row 1, column step_length_m") && err.contains("step_length_cm"),
+        "{err}"
+    );
+    let out = gaitfit(d)
+        .args(["fit", "--data", "t.csv", "--relation", "run-sl-x"])
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("unknown relation `run-sl-x`") && err.contains("run-sl-v"), "{err}");
-    let out = gaitfit(d).args(["check", "--fits", "nowhere"]).output().unwrap();
+    assert!(
+        err.contains("unknown relation `run-sl-x`") && err.contains("run-sl-v"),
+        "{err}"
+    );
+    let out = gaitfit(d)
+        .args(["check", "--fits", "nowhere"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(1));
 }

@@ -1,5 +1,6 @@
 //! Every fit's coefficients against an independent least-squares computation (closed-form or
 //! normal equations written out here, in a basis of the test's own choosing), to 1e-9 relative.
+#![allow(clippy::needless_range_loop)]
 use gaitfit::fit::pipeline::{fit_relation, FitOptions};
 use gaitfit::fit::synthetic::{synthetic_rows, SyntheticSpec};
 use gaitfit::ingest::trials::TrialsTable;
@@ -14,7 +15,10 @@ fn table(spec: SyntheticSpec) -> TrialsTable {
 
 fn close(a: f64, b: f64, what: &str) {
     let rel = (a - b).abs() / b.abs().max(1e-300);
-    assert!(rel < REL, "{what}: pipeline {a:e} vs independent {b:e} (rel {rel:e})");
+    assert!(
+        rel < REL,
+        "{what}: pipeline {a:e} vs independent {b:e} (rel {rel:e})"
+    );
 }
 
 /// Normal equations with column equilibration, solved by LU: independent of the pipeline's QR.
@@ -33,15 +37,23 @@ fn normal_equations(x: &DMatrix<f64>, y: &DVector<f64>) -> DVector<f64> {
 fn data_of(rel: &dyn Relation, t: &TrialsTable) -> Vec<([f64; 4], f64, String)> {
     (0..t.len())
         .filter(|&i| t.gait[i] == Some(rel.gait()))
-        .filter_map(|i| rel.observe(&t.values(i)).ok().map(|o| (o.x, o.y, t.subject_name(i).to_string())))
+        .filter_map(|i| {
+            rel.observe(&t.values(i))
+                .ok()
+                .map(|o| (o.x, o.y, t.subject_name(i).to_string()))
+        })
         .collect()
 }
 
 #[test]
 fn walk_sl_sf_is_the_closed_form_slope_through_the_origin() {
-    let t = table(SyntheticSpec { rows: 600, seed: 11, ..Default::default() });
+    let t = table(SyntheticSpec {
+        rows: 600,
+        seed: 11,
+        ..Default::default()
+    });
     let rel = WalkSlSf::published();
-    let o = fit_relation(&rel, &[t.clone()], &FitOptions::default()).unwrap();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
     let d = data_of(&rel, &t);
     let (sxy, sxx, syy) = d.iter().fold((0.0, 0.0, 0.0), |a, (x, y, _)| {
         let z = x[0] * x[1];
@@ -50,18 +62,29 @@ fn walk_sl_sf_is_the_closed_form_slope_through_the_origin() {
     let k = sxy / sxx;
     close(o.record.coefficient("k").unwrap().value, k, "k");
     // Uncentred r² (NIST): 1 − RSS/Σy².
-    let rss: f64 = d.iter().map(|(x, y, _)| (y - k * x[0] * x[1]).powi(2)).sum();
+    let rss: f64 = d
+        .iter()
+        .map(|(x, y, _)| (y - k * x[0] * x[1]).powi(2))
+        .sum();
     close(o.record.r2, 1.0 - rss / syy, "uncentred r²");
     let n = d.len() as f64;
-    close(o.record.coefficient("k").unwrap().std_error.unwrap(), (rss / (n - 1.0) / sxx).sqrt(), "se(k)");
+    close(
+        o.record.coefficient("k").unwrap().std_error.unwrap(),
+        (rss / (n - 1.0) / sxx).sqrt(),
+        "se(k)",
+    );
     assert!(o.record.r2_definition.starts_with("uncentred"));
 }
 
 #[test]
 fn walk_tds_sf_is_the_closed_form_simple_regression() {
-    let t = table(SyntheticSpec { rows: 600, seed: 12, ..Default::default() });
+    let t = table(SyntheticSpec {
+        rows: 600,
+        seed: 12,
+        ..Default::default()
+    });
     let rel = WalkTdsSf::published();
-    let o = fit_relation(&rel, &[t.clone()], &FitOptions::default()).unwrap();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
     let d = data_of(&rel, &t);
     let n = d.len() as f64;
     let mx = d.iter().map(|v| v.0[0]).sum::<f64>() / n;
@@ -75,16 +98,29 @@ fn walk_tds_sf_is_the_closed_form_simple_regression() {
     let rss: f64 = d.iter().map(|v| (v.1 - d0 - d1 * v.0[0]).powi(2)).sum();
     let syy: f64 = d.iter().map(|v| (v.1 - my).powi(2)).sum();
     close(o.record.r2, 1.0 - rss / syy, "r²");
-    close(o.record.residual_mean_square, rss / (n - 2.0), "residual mean square");
-    close(o.record.coefficient("d1").unwrap().std_error.unwrap(), (rss / (n - 2.0) / sxx).sqrt(), "se(d1)");
+    close(
+        o.record.residual_mean_square,
+        rss / (n - 2.0),
+        "residual mean square",
+    );
+    close(
+        o.record.coefficient("d1").unwrap().std_error.unwrap(),
+        (rss / (n - 2.0) / sxx).sqrt(),
+        "se(d1)",
+    );
     close(o.record.rmse, (rss / n).sqrt(), "rmse");
 }
 
 #[test]
 fn run_sl_v_with_levels_matches_normal_equations_at_the_profiled_v_norm() {
-    let t = table(SyntheticSpec { rows: 1200, subjects: 4, seed: 13, ..Default::default() });
+    let t = table(SyntheticSpec {
+        rows: 1200,
+        subjects: 4,
+        seed: 13,
+        ..Default::default()
+    });
     let rel = RunSlV::published();
-    let o = fit_relation(&rel, &[t.clone()], &FitOptions::default()).unwrap();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
     let vn = o.record.coefficient("v_norm").unwrap().value;
     assert!(o.record.coefficient("v_norm").unwrap().held.is_none());
     assert!((vn - 400.0).abs() < 10.0, "v_norm {vn}");
@@ -120,11 +156,19 @@ fn run_sl_v_with_levels_matches_normal_equations_at_the_profiled_v_norm() {
     close(o.record.coefficient("a").unwrap().value, beta[0], "a");
     close(o.record.coefficient("b").unwrap().value, b, "b");
     for (k, s) in subjects.iter().enumerate() {
-        close(o.record.coefficient(&format!("level[{s}]")).unwrap().value, beta[1 + k] - b, "level");
+        close(
+            o.record.coefficient(&format!("level[{s}]")).unwrap().value,
+            beta[1 + k] - b,
+            "level",
+        );
     }
     // The profiled v_norm is a minimum of the independent RSS.
     for dv in [-0.5, 0.5, -2.0, 2.0] {
-        assert!(rss_at(vn + dv).1 >= rss * (1.0 - 1e-12), "RSS lower at v_norm {}", vn + dv);
+        assert!(
+            rss_at(vn + dv).1 >= rss * (1.0 - 1e-12),
+            "RSS lower at v_norm {}",
+            vn + dv
+        );
     }
 }
 
@@ -152,9 +196,13 @@ fn raw_poly(xs: &[f64], ys: &[f64], deg: usize) -> Vec<f64> {
 
 #[test]
 fn run_tflight_sf_free_pieces_match_separate_polynomial_fits() {
-    let t = table(SyntheticSpec { rows: 1500, seed: 14, ..Default::default() });
+    let t = table(SyntheticSpec {
+        rows: 1500,
+        seed: 14,
+        ..Default::default()
+    });
     let rel = RunTflightSf::published();
-    let o = fit_relation(&rel, &[t.clone()], &FitOptions::default()).unwrap();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
     let k1 = o.record.coefficient("k1").unwrap().value;
     let k2 = o.record.coefficient("k2").unwrap().value;
     let d = data_of(&rel, &t);
@@ -175,7 +223,12 @@ fn run_tflight_sf_free_pieces_match_separate_polynomial_fits() {
     for (i, name) in ["c0", "c1", "c2", "c3"].iter().enumerate() {
         close(o.record.coefficient(name).unwrap().value, c[i], name);
     }
-    let jump = o.record.derived.iter().find(|d| d.name == "jump_at_k1").unwrap();
+    let jump = o
+        .record
+        .derived
+        .iter()
+        .find(|d| d.name == "jump_at_k1")
+        .unwrap();
     let cubic = |x: f64| c[0] + x * (c[1] + x * (c[2] + x * c[3]));
     let quad = |x: f64| q[0] + x * (q[1] + x * q[2]);
     assert!((jump.value - (cubic(k1) - quad(k1))).abs() < 1e-9);
@@ -184,9 +237,13 @@ fn run_tflight_sf_free_pieces_match_separate_polynomial_fits() {
 
 #[test]
 fn run_tflight_sf_continuous_matches_a_substituted_normal_equation_fit() {
-    let t = table(SyntheticSpec { rows: 1500, seed: 15, ..Default::default() });
+    let t = table(SyntheticSpec {
+        rows: 1500,
+        seed: 15,
+        ..Default::default()
+    });
     let rel = RunTflightSf::published_continuous();
-    let o = fit_relation(&rel, &[t.clone()], &FitOptions::default()).unwrap();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
     let k1 = o.record.coefficient("k1").unwrap().value;
     let k2 = o.record.coefficient("k2").unwrap().value;
     let d = data_of(&rel, &t);
@@ -218,6 +275,15 @@ fn run_tflight_sf_continuous_matches_a_substituted_normal_equation_fit() {
         let want = if sf < k1 { quad(sf) } else { cub(sf) };
         close(r.predict(&[sf]), want, &format!("t_flight({sf})"));
     }
-    let jump = o.record.derived.iter().find(|d| d.name == "jump_at_k1").unwrap();
-    assert!(jump.value.abs() < 1e-9, "continuous variant jumps by {}", jump.value);
+    let jump = o
+        .record
+        .derived
+        .iter()
+        .find(|d| d.name == "jump_at_k1")
+        .unwrap();
+    assert!(
+        jump.value.abs() < 1e-9,
+        "continuous variant jumps by {}",
+        jump.value
+    );
 }

@@ -14,7 +14,7 @@ much higher than a centred r² would be.",
     after_help = "Example:\n  gaitfit check --fits fits --min-r2 0.9"
 )]
 pub struct Args {
-    /// Folder with fits/<id>.json.
+    /// Folder with the fit records (one JSON file per relation).
     #[arg(long, value_name = "DIR", default_value = "fits")]
     pub fits: PathBuf,
     /// The bar: fits with r² below it fail.

@@ -15,7 +15,7 @@ Writes to standard output, or atomically to -o FILE.",
     after_help = "Example:\n  gaitfit export --fits fits --format rust -o src/gait_coeffs.rs"
 )]
 pub struct Args {
-    /// Folder with fits/<id>.json.
+    /// Folder with the fit records (one JSON file per relation).
     #[arg(long, value_name = "DIR", default_value = "fits")]
     pub fits: PathBuf,
     /// Output format.

@@ -35,7 +35,7 @@ pub struct Args {
     /// Relation id(s) to fit. Default: all (relations whose gait has no rows are skipped).
     #[arg(long = "relation", value_name = "ID", num_args = 1..)]
     pub relation: Vec<String>,
-    /// Folder for fits/<id>.json and .toml.
+    /// Folder for the fit records (JSON and TOML per relation).
     #[arg(long, value_name = "DIR", default_value = "fits")]
     pub fits: PathBuf,
     /// Folder for plots and summary.md.

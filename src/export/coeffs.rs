@@ -364,12 +364,14 @@ pub fn export(records: &[FitRecord], format: ExportFormat) -> Result<String, Exp
                     })?;
                 root.insert(r.relation.clone(), v);
             }
-            out.push_str(&toml::to_string_pretty(&toml::Value::Table(root)).map_err(|e| {
-                ExportError::Format {
-                    path: "export.toml".into(),
-                    message: e.to_string(),
-                }
-            })?);
+            out.push_str(
+                &toml::to_string_pretty(&toml::Value::Table(root)).map_err(|e| {
+                    ExportError::Format {
+                        path: "export.toml".into(),
+                        message: e.to_string(),
+                    }
+                })?,
+            );
             Ok(out)
         }
         ExportFormat::Csv => {

@@ -14,9 +14,11 @@ use thiserror::Error;
 
 pub mod nonlinear;
 pub mod ols;
+pub mod pipeline;
 pub mod prec;
 pub mod stats;
 pub mod strd;
+pub mod synthetic;
 
 /// Errors of the fitting layer.
 #[derive(Debug, Error)]

@@ -34,8 +34,7 @@
 use super::nonlinear::minimize_1d;
 use super::ols::{huber_irls, ols, LinearFit, LinearProblem};
 use super::stats::{
-    aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile,
-    TTest,
+    aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
 };
 use super::FitError;
 use crate::export::coeffs::{
@@ -162,7 +161,10 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
                 }
             }
             if t.is_flagged[i] {
-                let why = flags.get(&(i + 1)).copied().unwrap_or("inconsistent values");
+                let why = flags
+                    .get(&(i + 1))
+                    .copied()
+                    .unwrap_or("inconsistent values");
                 let kind = if why.contains("speed") {
                     "flagged: speed, step length and step frequency disagree by more than 2 %"
                 } else {
@@ -175,7 +177,12 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
                 Some(c) => {
                     let w = c[i];
                     if !(w.is_finite() && w > 0.0) {
-                        reject("weight missing or not positive".into(), &file, i + 1, &mut p);
+                        reject(
+                            "weight missing or not positive".into(),
+                            &file,
+                            i + 1,
+                            &mut p,
+                        );
                         continue;
                     }
                     w
@@ -343,8 +350,10 @@ fn solve_ne(
     subj_map: Option<&[usize]>,
 ) -> Option<(DVector<f64>, f64)> {
     let nc = lay.ncols();
-    let mut xtx = DMatrix::<f64>::zeros(nc, nc);
-    let mut xty = DVector::<f64>::zeros(nc);
+    // Accumulate into flat buffers (row-major, lower triangle by first index): this loop is the
+    // cost of every profile evaluation.
+    let mut acc = vec![0.0f64; nc * nc];
+    let mut aty = vec![0.0f64; nc];
     let mut yty = 0.0;
     let mut idx = [0usize; 17];
     let mut val = [0.0f64; 17];
@@ -357,9 +366,11 @@ fn solve_ne(
         yty += w * y * y;
         for a in 0..k {
             let wa = w * val[a];
-            xty[idx[a]] += wa * y;
+            let ia = idx[a];
+            aty[ia] += wa * y;
+            let rowa = &mut acc[ia * nc..ia * nc + nc];
             for b in 0..=a {
-                xtx[(idx[a], idx[b])] += wa * val[b];
+                rowa[idx[b]] += wa * val[b];
             }
         }
     };
@@ -367,14 +378,19 @@ fn solve_ne(
         Some(r) => r.iter().for_each(|&i| add(i)),
         None => (0..prep.obs.len()).for_each(&mut add),
     }
+    let mut xtx = DMatrix::<f64>::zeros(nc, nc);
     for a in 0..nc {
-        for b in 0..a {
-            let v = xtx[(a, b)] + xtx[(b, a)];
+        for b in 0..nc {
             // Entries were accumulated in either triangle depending on column order.
+            let v = if a == b {
+                acc[a * nc + a]
+            } else {
+                acc[a * nc + b] + acc[b * nc + a]
+            };
             xtx[(a, b)] = v;
-            xtx[(b, a)] = v;
         }
     }
+    let xty = DVector::from_vec(aty);
     // Equilibrate before Cholesky so that badly scaled columns do not fail it.
     let d: Vec<f64> = (0..nc)
         .map(|j| {
@@ -403,6 +419,75 @@ fn solve_ne(
     Some((beta, rss))
 }
 
+/// Above this many rows, breakpoints are first located on a deterministic subsample (every k-th
+/// row) and then refined on all rows within a few grid cells of the subsample's optimum: the
+/// full-data grid scan would cost ~100 passes over the data per breakpoint.
+pub const PROFILE_SUBSAMPLE: usize = 20_000;
+/// Up to this many rows, leave-one-subject-out refits the breakpoints in every fold; above it,
+/// only the linear coefficients (the record's `loso_note` says which).
+pub const LOSO_FULL_REFIT_MAX: usize = PROFILE_SUBSAMPLE;
+/// Grid points of the full-data refinement around the subsample optimum.
+const REFINE_GRID: usize = 6;
+
+/// SplitMix64: a fixed, well-mixed hash of a row index.
+fn splitmix64(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+/// A 1-D function for argmin's Brent minimiser; NaN is treated as +∞.
+struct OneD<F>(F);
+
+impl<F: Fn(f64) -> f64> argmin::core::CostFunction for OneD<F> {
+    type Param = f64;
+    type Output = f64;
+    fn cost(&self, x: &f64) -> Result<f64, argmin::core::Error> {
+        let v = (self.0)(*x);
+        Ok(if v.is_nan() { f64::INFINITY } else { v })
+    }
+}
+
+/// Minimises `f` on `[lo, hi]` with a short grid and argmin's Brent method (for the full-data
+/// refinement after a subsample search).
+fn refine_1d<F: Fn(f64) -> f64>(f: F, lo: f64, hi: f64, tol: f64) -> Result<f64, FitError> {
+    // Breakpoints need no more than a millionth of their search range.
+    let tol = tol.max((hi - lo).abs() * 1e-5);
+    let grid: Vec<(f64, f64)> = (0..=REFINE_GRID)
+        .map(|k| {
+            let x = lo + (hi - lo) * k as f64 / REFINE_GRID as f64;
+            (x, f(x))
+        })
+        .collect();
+    let (kb, &(xb, fb)) = grid
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .ok_or_else(|| FitError::Optimizer {
+            relation: "profile".into(),
+            message: "empty grid".into(),
+        })?;
+    let a = grid[kb.saturating_sub(1)].0;
+    let b = grid[(kb + 1).min(REFINE_GRID)].0;
+    if b <= a {
+        return Ok(xb);
+    }
+    let solver = argmin::solver::brent::BrentOpt::new(a, b).set_tolerance(f64::EPSILON.sqrt(), tol);
+    let res = argmin::core::Executor::new(OneD(&f), solver)
+        .configure(|st| st.max_iters(200))
+        .timer(false)
+        .run()
+        .map_err(|e| FitError::Optimizer {
+            relation: "profile".into(),
+            message: e.to_string(),
+        })?;
+    let xr = argmin::core::State::get_best_param(res.state())
+        .copied()
+        .unwrap_or(xb);
+    Ok(if f(xr) <= fb { xr } else { xb })
+}
+
 /// Profiles the free breakpoints (coordinate descent), returning the updated parameters.
 fn profile(
     rel: &dyn Relation,
@@ -413,22 +498,85 @@ fn profile(
     rows: Option<&[usize]>,
     subj_map: Option<&[usize]>,
 ) -> Result<Vec<f64>, FitError> {
+    profile_with(rel, lay, p0, search, prep, rows, subj_map, true)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn profile_with(
+    rel: &dyn Relation,
+    lay: &Layout,
+    p0: &[f64],
+    search: &[Option<(f64, f64)>],
+    prep: &Prepared,
+    rows: Option<&[usize]>,
+    subj_map: Option<&[usize]>,
+    allow_subsample: bool,
+) -> Result<Vec<f64>, FitError> {
     let bps: Vec<usize> = (0..p0.len())
         .filter(|&i| lay.free[i] && rel.parameters()[i].kind == ParamKind::Breakpoint)
         .collect();
     let mut p = p0.to_vec();
-    let rounds = if bps.len() > 1 { 3 } else { 1 };
-    for _ in 0..rounds {
+    if bps.is_empty() {
+        return Ok(p);
+    }
+    let n = rows.map_or(prep.obs.len(), |r| r.len());
+    // A fixed pseudo-random subsample (a hash of the row index, so periodic row orders such as
+    // subjects taking turns cannot alias into a one-subject sample).
+    let sub: Option<Vec<usize>> = (allow_subsample && n > PROFILE_SUBSAMPLE).then(|| {
+        let k = n.div_ceil(PROFILE_SUBSAMPLE) as u64;
+        let keep = |i: usize| splitmix64(i as u64) % k == 0;
+        match rows {
+            Some(r) => r.iter().copied().filter(|&i| keep(i)).collect(),
+            None => (0..n).filter(|&i| keep(i)).collect(),
+        }
+    });
+    let max_rounds = if bps.len() > 1 { 4 } else { 1 };
+    // Coordinate descent with a full search per breakpoint, on the subsample when there is one.
+    let search_rows: Option<&[usize]> = sub.as_deref().or(rows);
+    let mut sub_ok = true;
+    for _ in 0..max_rounds {
+        let mut moved = 0.0f64;
         for &i in &bps {
             let Some((lo, hi)) = search[i] else { continue };
+            let tol = (hi - lo).abs() * 1e-7;
             let f = |t: f64| {
                 let mut q = p.clone();
                 q[i] = t;
-                solve_ne(rel, lay, &q, prep, rows, subj_map).map_or(f64::INFINITY, |(_, r)| r)
+                solve_ne(rel, lay, &q, prep, search_rows, subj_map).map_or(f64::INFINITY, |r| r.1)
             };
-            let tol = (hi - lo).abs() * 1e-7;
-            let (t, _) = minimize_1d(f, lo, hi, tol)?;
+            let t = match minimize_1d(f, lo, hi, tol) {
+                Ok((t, _)) => t,
+                // The subsample could not be fitted (e.g. too few subjects in it).
+                Err(_) if sub.is_some() => {
+                    sub_ok = false;
+                    break;
+                }
+                Err(e) => return Err(e),
+            };
+            moved = moved.max((t - p[i]).abs() / (hi - lo).abs().max(f64::MIN_POSITIVE));
             p[i] = t;
+        }
+        if !sub_ok || moved < 1e-6 {
+            break;
+        }
+    }
+    if sub.is_some() {
+        if !sub_ok {
+            return profile_with(rel, lay, p0, search, prep, rows, subj_map, false);
+        }
+        // Refine on all rows within a few grid cells of the subsample's optimum.
+        for _ in 0..max_rounds.min(2) {
+            for &i in &bps {
+                let Some((lo, hi)) = search[i] else { continue };
+                let tol = (hi - lo).abs() * 1e-7;
+                let h = 4.0 * (hi - lo) / 64.0;
+                let f = |t: f64| {
+                    let mut q = p.clone();
+                    q[i] = t;
+                    solve_ne(rel, lay, &q, prep, rows, subj_map).map_or(f64::INFINITY, |r| r.1)
+                };
+                p[i] = refine_1d(f, (p[i] - h).max(lo), (p[i] + h).min(hi), tol)?;
+            }
         }
     }
     Ok(p)
@@ -456,6 +604,7 @@ fn refit_subset(
     p_start: &[f64],
     prep: &Prepared,
     rows: &[usize],
+    refit_breakpoints: bool,
 ) -> Option<Vec<f64>> {
     let (map, n_subj) = dense_subjects(prep, rows);
     let sub_obs: Vec<Observation> = rows.iter().map(|&i| prep.obs[i]).collect();
@@ -463,7 +612,8 @@ fn refit_subset(
     let mut free = free.to_vec();
     let mut search = plan.search.clone();
     for i in 0..free.len() {
-        if rel.parameters()[i].kind == ParamKind::Breakpoint && (!free[i] || search[i].is_none())
+        if rel.parameters()[i].kind == ParamKind::Breakpoint
+            && (!free[i] || search[i].is_none() || !refit_breakpoints)
         {
             free[i] = false;
             search[i] = None;
@@ -553,7 +703,10 @@ pub fn fit_relation(
     if n < n_params_max + 2 {
         let mut why = String::new();
         if let Some(r) = prep.rejected.first() {
-            why = format!(" ({} rows rejected; most common: {})", prep.n_rejected, r.reason);
+            why = format!(
+                " ({} rows rejected; most common: {})",
+                prep.n_rejected, r.reason
+            );
         }
         return Err(FitError::TooFew {
             relation: format!("{id}{why}"),
@@ -589,7 +742,8 @@ pub fn fit_relation(
         let df = n as f64 - n_params_max as f64;
         let f = (rss0 - rss1) / (rss1 / df);
         let pval = super::stats::t_two_sided_p(f.max(0.0).sqrt(), df);
-        if !(pval < BREAKPOINT_TEST_ALPHA) {
+        // A NaN p-value (degenerate test) also keeps the published value.
+        if pval.is_nan() || pval >= BREAKPOINT_TEST_ALPHA {
             free[i] = false;
             held_reason[i] = Some(format!(
                 "held at the published value: the data show no {} (best {} = {:.4}, F-test \
@@ -689,7 +843,10 @@ pub fn fit_relation(
     let residuals: Vec<f64> = (0..n).map(|i| obs_y[i] - fitted[i]).collect();
     let wopt = weighted.then_some(prep.weights.as_slice());
     let (r2, r2_def) = if rel.has_intercept() {
-        (r2_centred(&obs_y, rss, wopt), "centred: 1 − RSS/Σ(y − ȳ)²".to_string())
+        (
+            r2_centred(&obs_y, rss, wopt),
+            "centred: 1 − RSS/Σ(y − ȳ)²".to_string(),
+        )
     } else {
         (
             r2_uncentred(&obs_y, rss, wopt),
@@ -750,7 +907,11 @@ pub fn fit_relation(
             published: published[i],
             t_test,
             ci95_bootstrap: None,
-            held: if free[i] { None } else { held_reason[i].clone() },
+            held: if free[i] {
+                None
+            } else {
+                held_reason[i].clone()
+            },
             flag: None,
         });
     }
@@ -805,8 +966,9 @@ pub fn fit_relation(
     // Leave-one-subject-out.
     let (loso_rmse, loso_note) = if n_subj >= 3 {
         let groups = prep.subject.clone();
+        let refit_bp = n <= LOSO_FULL_REFIT_MAX;
         let res = leave_one_group_out(&groups, |train, test| {
-            let q = refit_subset(rel, &free, &p, &prep, train)?;
+            let q = refit_subset(rel, &free, &p, &prep, train, refit_bp)?;
             Some(
                 test.iter()
                     .map(|&i| (prep.obs[i].y - rel.predict_with(&q, 0.0, &prep.obs[i].x)).powi(2))
@@ -818,22 +980,30 @@ pub fn fit_relation(
         if folds == n_subj && !sq.is_empty() {
             (
                 Some((sq.iter().sum::<f64>() / sq.len() as f64).sqrt()),
-                format!(
-                    "{n_subj} folds; each subject predicted (level 0) from a full refit, \
-                     breakpoints included, on the others"
-                ),
+                if refit_bp || n_bp == 0 {
+                    format!(
+                        "{n_subj} folds; each subject predicted (level 0) from a full refit, \
+                         breakpoints included, on the others"
+                    )
+                } else {
+                    format!(
+                        "{n_subj} folds; each subject predicted (level 0) from a refit of the \
+                         linear coefficients on the others, breakpoints held at the all-subject \
+                         estimate (more than {LOSO_FULL_REFIT_MAX} rows)"
+                    )
+                },
             )
         } else {
             (
                 None,
-                format!("{} of {n_subj} leave-one-subject-out refits failed", n_subj - folds),
+                format!(
+                    "{} of {n_subj} leave-one-subject-out refits failed",
+                    n_subj - folds
+                ),
             )
         }
     } else {
-        (
-            None,
-            format!("needs at least 3 subjects (have {n_subj})"),
-        )
+        (None, format!("needs at least 3 subjects (have {n_subj})"))
     };
 
     // Published coefficients on the same rows.
@@ -877,7 +1047,11 @@ pub fn fit_relation(
                 published: published[i],
                 t_test: None,
                 ci95_bootstrap: None,
-                held: if free[i] { None } else { held_reason[i].clone() },
+                held: if free[i] {
+                    None
+                } else {
+                    held_reason[i].clone()
+                },
                 flag: None,
             });
             j += 1;
@@ -899,7 +1073,7 @@ pub fn fit_relation(
         let groups = prep.subject.clone();
         let idx_free: Vec<usize> = (0..specs.len()).filter(|&i| free[i]).collect();
         let summary = bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
-            let q = refit_subset(rel, &free, &p, &prep, rows)?;
+            let q = refit_subset(rel, &free, &p, &prep, rows, true)?;
             Some(idx_free.iter().map(|&i| q[i]).collect())
         });
         for (k, &i) in idx_free.iter().enumerate() {
@@ -949,9 +1123,12 @@ pub fn fit_relation(
         .iter()
         .enumerate()
         .map(|(j, v)| {
-            let (lo, hi) = prep.obs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, o| {
-                (a.0.min(o.x[j]), a.1.max(o.x[j]))
-            });
+            let (lo, hi) = prep
+                .obs
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |a, o| {
+                    (a.0.min(o.x[j]), a.1.max(o.x[j]))
+                });
             RangeRecord {
                 input: v.symbol.to_string(),
                 unit: v.unit.to_string(),
@@ -1081,14 +1258,23 @@ fn profile_interval(
     };
     let rmin = rss(p[i]);
     let thr = rmin * (1.0 + tq * tq / df);
+    // Step outward geometrically (narrow intervals on large data are found in a few steps),
+    // then bisect to 0.1 % of the half-width.
     let find = |end: f64| -> Option<f64> {
-        const STEPS: usize = 24;
+        let span = end - p[i];
+        if span == 0.0 {
+            return None;
+        }
         let mut inside = p[i];
-        for s in 1..=STEPS {
-            let t = p[i] + (end - p[i]) * s as f64 / STEPS as f64;
+        let mut frac: f64 = 1e-4;
+        loop {
+            let t = p[i] + span * frac.min(1.0);
             if rss(t) > thr {
                 let (mut a, mut b) = (inside, t);
                 for _ in 0..40 {
+                    if (b - a).abs() <= 1e-3 * (b - p[i]).abs() {
+                        break;
+                    }
                     let m = 0.5 * (a + b);
                     if rss(m) > thr {
                         b = m;
@@ -1098,9 +1284,12 @@ fn profile_interval(
                 }
                 return Some(0.5 * (a + b));
             }
+            if frac >= 1.0 {
+                return None;
+            }
             inside = t;
+            frac *= 2.0;
         }
-        None
     };
     Ok((find(lo), find(hi)))
 }

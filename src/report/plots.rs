@@ -58,7 +58,9 @@ fn main_plot<DB: DrawingBackend>(
         .prepared
         .obs
         .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, b| (a.0.min(b.x[0]), a.1.max(b.x[0])));
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, b| {
+            (a.0.min(b.x[0]), a.1.max(b.x[0]))
+        });
     let (xlo, xhi) = pad(xlo, xhi);
     const K: usize = 200;
     let curve: Vec<(f64, f64, f64, f64, f64)> = (0..=K)
@@ -76,7 +78,9 @@ fn main_plot<DB: DrawingBackend>(
         .iter()
         .map(|o| o.y)
         .chain(curve.iter().flat_map(|c| [c.1, c.2, c.3]));
-    let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| (a.0.min(y), a.1.max(y)));
+    let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
+        (a.0.min(y), a.1.max(y))
+    });
     let (ylo, yhi) = pad(ylo, yhi);
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let others: Vec<String> = inputs
@@ -162,12 +166,12 @@ fn scatter_plot<DB: DrawingBackend>(
     pts: &[(f64, f64)],
     reference: Option<(f64, f64)>,
 ) -> Result<(), String> {
-    let (xlo, xhi) = pts
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| (a.0.min(p.0), a.1.max(p.0)));
-    let (ylo, yhi) = pts
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| (a.0.min(p.1), a.1.max(p.1)));
+    let (xlo, xhi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+        (a.0.min(p.0), a.1.max(p.0))
+    });
+    let (ylo, yhi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+        (a.0.min(p.1), a.1.max(p.1))
+    });
     let (xlo, xhi) = pad(xlo, xhi);
     let (ylo, yhi) = pad(ylo, yhi);
     root.fill(&WHITE).map_err(|e| e.to_string())?;
@@ -209,7 +213,11 @@ pub fn write_plots(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, ReportErr
         return Ok(Vec::new());
     }
     let mut out = Vec::new();
-    out.extend(write_pair(&dir.join(&id), |a| main_plot(a, o), |a| main_plot(a, o))?);
+    out.extend(write_pair(
+        &dir.join(&id),
+        |a| main_plot(a, o),
+        |a| main_plot(a, o),
+    )?);
     let resp = o.refit.response();
     let rf: Vec<(f64, f64)> = o
         .fitted
@@ -273,6 +281,7 @@ where
         png_draw(&root).map_err(|e| perr(&png_path, e))?;
         root.present().map_err(|e| perr(&png_path, e))?;
     }
-    tmp.persist(&png_path).map_err(|e| perr(&png_path, e.error))?;
+    tmp.persist(&png_path)
+        .map_err(|e| perr(&png_path, e.error))?;
     Ok(vec![svg_path, png_path])
 }

@@ -34,7 +34,10 @@ pub fn render_summary(records: &[FitRecord], failures: &[(String, String)]) -> S
          refit coefficient with its published value.\n",
         crate::GAITFIT_VERSION
     );
-    let _ = writeln!(s, "| relation | n | subjects | r² | published r² | rmse | published rmse | LOSO rmse |");
+    let _ = writeln!(
+        s,
+        "| relation | n | subjects | r² | published r² | rmse | published rmse | LOSO rmse |"
+    );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|");
     for r in records {
         let _ = writeln!(
@@ -52,7 +55,11 @@ pub fn render_summary(records: &[FitRecord], failures: &[(String, String)]) -> S
         );
     }
     for (id, why) in failures {
-        let _ = writeln!(s, "| `{id}` | — | — | not fitted: {} | | | | |", why.replace('|', "/"));
+        let _ = writeln!(
+            s,
+            "| `{id}` | — | — | not fitted: {} | | | | |",
+            why.replace('|', "/")
+        );
     }
     for r in records {
         let _ = writeln!(s, "\n## {}\n", r.relation);
