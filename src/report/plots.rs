@@ -77,7 +77,7 @@ fn main_plot<DB: DrawingBackend>(
         .obs
         .iter()
         .map(|o| o.y)
-        .chain(curve.iter().flat_map(|c| [c.1, c.2, c.3]));
+        .chain(curve.iter().flat_map(|c| [c.1, c.2, c.3, c.4]));
     let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
         (a.0.min(y), a.1.max(y))
     });
