@@ -5,3 +5,4 @@ pub mod dynamics;
 pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
+pub mod shooting;
