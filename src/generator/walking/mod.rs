@@ -2,7 +2,10 @@
 pub mod attributes;
 pub mod body;
 pub mod dynamics;
+pub mod foot;
 pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
 pub mod shooting;
+pub mod stance;
+pub mod track;

@@ -1,0 +1,232 @@
+//! The stance phase (§4.2): the telescopic inverted pendulum with upper body, its subphases and
+//! force profiles, and the shooting for `F_θ1` and `F_w`.
+//!
+//! Force profiles:
+//! - `F_θ1`: a step torque of magnitude `A`, switched off at `hip_torque_off · t_step` (§4.2:
+//!   0.4); `A` is a shooting unknown.
+//! - `F_θ2 = −k2 (θ2 − θ2_ref) − c2 θ̇2`: the spring–damper that balances the upper body; `k2`
+//!   includes the upper body's gravitational stiffness `m2 g r2` so the natural frequency is the
+//!   attribute's.
+//! - `F_w = k_w (l1 + pa − w) − v_w ẇ` (eq. 4; the equation itself is missing from the paper's
+//!   text, which describes its terms: spring and damping constants `k_w`, `v_w`, unloaded length
+//!   `l1`, leg length `w`, velocity `ẇ` and the position actuator `pa`, initially zero).
+//!
+//! Subphases, switched by events located on the discrete flow (the middle-level state machine):
+//! 1. *compression* (telescopic, A.1): the leg shortens after heel strike (knee flexion). The
+//!    position actuator monitors the hip: while the hip is below its height at heel strike, `pa`
+//!    rises at `monitor_gain · (y_hs − y_hip)` ("if it drops too low, pa is increased").
+//! 2. *rigid* (A.1 with correction 3): when the leg regains its unloaded length `l1` before it
+//!    passes the vertical it is locked (`ẇ = 0`; the locking impulse acts along the leg, so the
+//!    generalized momenta of `θ1` and `θ2` are conserved).
+//! 3. *extension* (telescopic): from the event `θ1 > 0` (leg passes the vertical) the lock is
+//!    removed with `pa` set so that `F_w` equals the leg's reaction (no jump in force), and `pa`
+//!    grows as `pa_u + P·τ²` (τ the fraction of the remaining time) to extend the leg — plantar
+//!    flexion — to its desired length at the end of the step; `P` is a shooting unknown.
+//!
+//! The paper also locks the leg when it reaches its desired length before the end of the step;
+//! here the shooting makes it reach that length exactly at the end, so that lock never engages
+//! and is not implemented.
+use super::dynamics::{solve2, StanceModel};
+use super::integrate::{integrate, stable_step, spectral_radius};
+use super::shooting::{solve_2d, Solved};
+use super::track::{Node, Track};
+
+/// Everything that defines one stance phase except its two shooting unknowns.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceSpec {
+    /// The model.
+    pub model: StanceModel,
+    /// Unloaded leg length `l1`, m.
+    pub l1: f64,
+    /// Leg spring stiffness `k_w`, N/m.
+    pub k_w: f64,
+    /// Leg damping `v_w`, N·s/m.
+    pub v_w: f64,
+    /// Upper body spring, N·m/rad.
+    pub k2: f64,
+    /// Upper body damper, N·m·s/rad.
+    pub c2: f64,
+    /// Upper body reference angle, rad.
+    pub theta2_ref: f64,
+    /// Step duration `t_step`, s.
+    pub duration: f64,
+    /// Time `F_θ1` is switched off, s.
+    pub torque_off: f64,
+    /// Position-actuator monitor gain, 1/s.
+    pub monitor_gain: f64,
+    /// Final conditions `[w, θ1]` at `t_step`.
+    pub target: [f64; 2],
+    /// Largest integration step, s.
+    pub max_step: f64,
+}
+
+/// Initial state of a stance phase.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StanceStart {
+    /// `[w, θ1, θ2]`.
+    pub q: [f64; 3],
+    /// `[ẇ, θ̇1, θ̇2]`.
+    pub qd: [f64; 3],
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Sub {
+    CompressAbove,
+    CompressBelow,
+    Rigid,
+    Extend,
+}
+
+/// Outcome of one simulated stance phase.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StanceRun {
+    /// Final `[w, θ1, θ2, ẇ, θ̇1, θ̇2]`.
+    pub end: [f64; 6],
+    /// Time the leg was locked, s.
+    pub lock_time: Option<f64>,
+    /// Time the leg passed the vertical (unlock / start of extension), s.
+    pub extend_time: Option<f64>,
+    /// The trajectory (only when recorded).
+    pub track: Track<3>,
+}
+
+impl StanceSpec {
+    fn forces(&self, t: f64, y: &[f64; 7], a: f64, sub: Sub, ext: (f64, f64, f64)) -> [f64; 3] {
+        let f1 = if t < self.torque_off { a } else { 0.0 };
+        let f2 = -self.k2 * (y[2] - self.theta2_ref) - self.c2 * y[5];
+        let pa = match sub {
+            Sub::Extend => {
+                let (t_u, pa_u, p) = ext;
+                let tau = ((t - t_u) / (self.duration - t_u).max(1e-9)).clamp(0.0, 1.0);
+                pa_u + p * tau * tau
+            }
+            _ => y[6],
+        };
+        let fw = self.k_w * (self.l1 + pa - y[0]) - self.v_w * y[3];
+        [fw, f1, f2]
+    }
+
+    fn deriv(&self, t: f64, y: &[f64; 7], a: f64, sub: Sub, ext: (f64, f64, f64), floor: f64) -> [f64; 7] {
+        let q = [y[0], y[1], y[2]];
+        let qd = [y[3], y[4], y[5]];
+        let f = self.forces(t, y, a, sub, ext);
+        let acc = self.model.accel(&q, &qd, &f, sub == Sub::Rigid);
+        let pa_rate = match sub {
+            Sub::CompressAbove | Sub::CompressBelow => {
+                self.monitor_gain * (floor - y[0] * y[1].cos()).max(0.0)
+            }
+            _ => 0.0,
+        };
+        [y[3], y[4], y[5], acc[0], acc[1], acc[2], pa_rate]
+    }
+
+    /// The integration step: the attribute's maximum, reduced if the stiffness requires it
+    /// (see [`super::integrate`]).
+    pub fn step(&self, start: &StanceStart) -> f64 {
+        let y = [start.q[0], start.q[1], start.q[2], start.qd[0], start.qd[1], start.qd[2]];
+        let mut f = |t: f64, y6: &[f64; 6]| {
+            let y7 = [y6[0], y6[1], y6[2], y6[3], y6[4], y6[5], 0.0];
+            let d = self.deriv(t, &y7, 0.0, Sub::Extend, (0.0, 0.0, 0.0), 0.0);
+            [d[0], d[1], d[2], d[3], d[4], d[5]]
+        };
+        stable_step(spectral_radius(&mut f, 0.0, &y), self.max_step)
+    }
+
+    /// Simulates the phase with step-torque magnitude `a` (N·m) and extension amplitude `p` (m).
+    pub fn run(&self, start: &StanceStart, a: f64, p: f64, h: f64, record: bool) -> StanceRun {
+        let floor = start.q[0] * start.q[1].cos();
+        let m2g = self.model.m2 * self.model.g;
+        // pa starts at the static preload of the upper body's weight (rest length l1 under load).
+        let pa0 = m2g * start.q[1].cos() / self.k_w;
+        let mut y = [start.q[0], start.q[1], start.q[2], start.qd[0], start.qd[1], start.qd[2], pa0];
+        let mut t = 0.0;
+        let mut sub = if y[1] >= 0.0 {
+            Sub::Extend
+        } else if y[0] > self.l1 {
+            Sub::CompressAbove
+        } else {
+            Sub::CompressBelow
+        };
+        let mut ext = (0.0, pa0, p);
+        let mut lock_time = None;
+        let mut extend_time = if sub == Sub::Extend { Some(0.0) } else { None };
+        let mut track = Track::default();
+        let node = |spec: &StanceSpec, t: f64, y: &[f64; 7], sub: Sub, ext| {
+            let d = spec.deriv(t, y, a, sub, ext, floor);
+            Node { t, q: [y[0], y[1], y[2]], qd: [y[3], y[4], y[5]], qdd: [d[3], d[4], d[5]] }
+        };
+        while t < self.duration {
+            let t_end = if t < self.torque_off { self.torque_off.min(self.duration) } else { self.duration };
+            if record {
+                track.push(node(self, t, &y, sub, ext));
+            }
+            let spec = *self;
+            let mut f = |tt: f64, yy: &[f64; 7]| spec.deriv(tt, yy, a, sub, ext, floor);
+            let l1 = self.l1;
+            let mut ev = |_tt: f64, yy: &[f64; 7]| match sub {
+                Sub::CompressAbove => (l1 - yy[0]).max(yy[1]),
+                Sub::CompressBelow => (yy[0] - l1).max(yy[1]),
+                Sub::Rigid => yy[1],
+                Sub::Extend => -1.0,
+            };
+            let mut tr: Vec<Node<3>> = Vec::new();
+            let mut obs = |_t0: f64, _y0: &[f64; 7], t1: f64, y1: &[f64; 7]| {
+                if record {
+                    tr.push(node(&spec, t1, y1, sub, ext));
+                }
+            };
+            let seg = integrate(&mut f, t, y, t_end, h, Some(&mut ev), &mut obs);
+            track.nodes.extend(tr);
+            t = seg.t;
+            y = seg.y;
+            if !seg.event {
+                continue;
+            }
+            // Switch subphase.
+            if y[1] >= 0.0 {
+                let pa_u = if sub == Sub::Rigid {
+                    let q = [y[0], y[1], y[2]];
+                    let qd = [y[3], y[4], y[5]];
+                    let f = self.forces(t, &y, a, sub, ext);
+                    self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
+                } else {
+                    y[6]
+                };
+                ext = (t, pa_u, p);
+                extend_time = Some(t);
+                sub = Sub::Extend;
+            } else if sub == Sub::CompressAbove {
+                sub = Sub::CompressBelow;
+            } else if sub == Sub::CompressBelow {
+                // Lock: the impulse acts along the leg only.
+                let q = [y[0], y[1], y[2]];
+                let m = self.model.mass_matrix(&q);
+                let p1 = m[1][0] * y[3] + m[1][1] * y[4] + m[1][2] * y[5];
+                let p2 = m[2][0] * y[3] + m[2][1] * y[4] + m[2][2] * y[5];
+                let v = solve2(&[[m[1][1], m[1][2]], [m[2][1], m[2][2]]], &[p1, p2]);
+                y[3] = 0.0;
+                y[4] = v[0];
+                y[5] = v[1];
+                lock_time = Some(t);
+                sub = Sub::Rigid;
+            }
+        }
+        if record {
+            track.push(node(self, t, &y, sub, ext));
+        }
+        StanceRun { end: [y[0], y[1], y[2], y[3], y[4], y[5]], lock_time, extend_time, track }
+    }
+
+    /// Finds `A` and `P` so that `w(t_step)` and `θ1(t_step)` meet the targets, starting from the
+    /// previous step's values `guess`, and returns them with the recorded run.
+    pub fn solve(&self, start: &StanceStart, guess: [f64; 2]) -> Result<(Solved<2>, StanceRun), String> {
+        let h = self.step(start);
+        let f = |x: [f64; 2]| {
+            let r = self.run(start, x[0], x[1], h, false);
+            [r.end[1] - self.target[1], r.end[0] - self.target[0]]
+        };
+        let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 80)?;
+        let run = self.run(start, solved.x[0], solved.x[1], h, true);
+        Ok((solved, run))
+    }
+}

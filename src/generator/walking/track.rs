@@ -1,0 +1,127 @@
+//! Recorded trajectories of a phase: nodes `(t, q, q̇, q̈)` and quintic Hermite interpolation
+//! between them (exact in position, velocity and acceleration at the nodes), so the swing
+//! simulation can read the stance hip's acceleration at any instant.
+
+/// One recorded node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node<const N: usize> {
+    /// Time, s.
+    pub t: f64,
+    /// Coordinates.
+    pub q: [f64; N],
+    /// Velocities.
+    pub qd: [f64; N],
+    /// Accelerations (the limit from inside the interval that follows, or precedes for the last
+    /// node of a segment).
+    pub qdd: [f64; N],
+}
+
+/// A recorded trajectory. Segment boundaries (where the equations switch) appear as two nodes at
+/// the same time; interpolation never crosses them.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Track<const N: usize> {
+    /// The nodes in time order.
+    pub nodes: Vec<Node<N>>,
+}
+
+impl<const N: usize> Track<N> {
+    /// Appends a node (times must not decrease).
+    pub fn push(&mut self, n: Node<N>) {
+        self.nodes.push(n);
+    }
+
+    /// First and last time.
+    pub fn span(&self) -> (f64, f64) {
+        match (self.nodes.first(), self.nodes.last()) {
+            (Some(a), Some(b)) => (a.t, b.t),
+            _ => (0.0, 0.0),
+        }
+    }
+
+    /// Times where two nodes coincide (switches of the equations of motion).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        self.nodes.windows(2).filter(|w| w[1].t == w[0].t).map(|w| w[0].t).collect()
+    }
+
+    /// `(q, q̇, q̈)` at `t` (clamped to the span). For `t` on a breakpoint the later segment is
+    /// used.
+    pub fn at(&self, t: f64) -> ([f64; N], [f64; N], [f64; N]) {
+        let n = self.nodes.len();
+        if n == 0 {
+            return ([0.0; N], [0.0; N], [0.0; N]);
+        }
+        if n == 1 || t <= self.nodes[0].t {
+            let a = &self.nodes[0];
+            return (a.q, a.qd, a.qdd);
+        }
+        if t >= self.nodes[n - 1].t {
+            let a = &self.nodes[n - 1];
+            return (a.q, a.qd, a.qdd);
+        }
+        // Last node with time ≤ t, then skip zero-length intervals forward.
+        let mut k = self.nodes.partition_point(|x| x.t <= t).saturating_sub(1);
+        while k + 1 < n && self.nodes[k + 1].t == self.nodes[k].t {
+            k += 1;
+        }
+        if k + 1 >= n {
+            let a = &self.nodes[n - 1];
+            return (a.q, a.qd, a.qdd);
+        }
+        let (a, b) = (&self.nodes[k], &self.nodes[k + 1]);
+        let h = b.t - a.t;
+        let s = (t - a.t) / h;
+        let mut q = [0.0; N];
+        let mut qd = [0.0; N];
+        let mut qdd = [0.0; N];
+        for i in 0..N {
+            let c0 = a.q[i];
+            let c1 = h * a.qd[i];
+            let c2 = 0.5 * h * h * a.qdd[i];
+            let p = b.q[i] - c0 - c1 - c2;
+            let v = h * b.qd[i] - c1 - 2.0 * c2;
+            let acc = h * h * b.qdd[i] - 2.0 * c2;
+            let c3 = 10.0 * p - 4.0 * v + 0.5 * acc;
+            let c4 = -15.0 * p + 7.0 * v - acc;
+            let c5 = 6.0 * p - 3.0 * v + 0.5 * acc;
+            q[i] = c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
+            qd[i] = (c1 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)))) / h;
+            qdd[i] = (2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5))) / (h * h);
+        }
+        (q, qd, qdd)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quintic_hermite_reproduces_smooth_motion() {
+        let f = |t: f64| (2.0 * t).sin();
+        let mut tr = Track::<1>::default();
+        for k in 0..=50 {
+            let t = k as f64 * 0.02;
+            tr.push(Node { t, q: [f(t)], qd: [2.0 * (2.0 * t).cos()], qdd: [-4.0 * f(t)] });
+        }
+        for k in 0..97 {
+            let t = 0.0103 * k as f64;
+            let (q, qd, qdd) = tr.at(t);
+            assert!((q[0] - f(t)).abs() < 1e-12);
+            assert!((qd[0] - 2.0 * (2.0 * t).cos()).abs() < 1e-9);
+            assert!((qdd[0] + 4.0 * f(t)).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn breakpoints_split_the_interpolation() {
+        let mut tr = Track::<1>::default();
+        tr.push(Node { t: 0.0, q: [0.0], qd: [0.0], qdd: [1.0] });
+        tr.push(Node { t: 1.0, q: [0.5], qd: [1.0], qdd: [1.0] });
+        tr.push(Node { t: 1.0, q: [0.5], qd: [1.0], qdd: [-1.0] });
+        tr.push(Node { t: 2.0, q: [1.0], qd: [0.0], qdd: [-1.0] });
+        assert_eq!(tr.breakpoints(), vec![1.0]);
+        assert!((tr.at(0.5).2[0] - 1.0).abs() < 1e-12);
+        assert!((tr.at(1.5).2[0] + 1.0).abs() < 1e-12);
+        assert!((tr.at(1.5).0[0] - (0.5 + 0.5 - 0.125)).abs() < 1e-12);
+    }
+}
