@@ -8,4 +8,5 @@ pub mod integrate;
 pub mod lagrange;
 pub mod shooting;
 pub mod stance;
+pub mod swing;
 pub mod track;

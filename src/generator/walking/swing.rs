@@ -1,0 +1,435 @@
+//! The swing phase (§4.3): a double pendulum hanging from the moving swing hip, in three
+//! subphases whose durations are known beforehand (ends at `swing1_end` and `swing2_end` of the
+//! swing, about 50 % and 85 %):
+//! - *swing1* (toe-off → t1): hip torque `F_θ3 = A·e^{−(t−t0)/τ}`, `A` found so that `θ3(t1)` is
+//!   the heel-strike value; the knee is locked in the dynamics (eq. 5 with correction 4) and its
+//!   angle is set, at every evaluation, so that the ankle lies on the 4th-order polynomial `P`
+//!   through the five conditions of §4.3;
+//! - *swing2* (t1 → t2): hip held by a spring–damper about the heel-strike angle, knee torque
+//!   `F_θ4 = B·e^{−(t−t1)/τ}`, `B` found so that the knee is straight (`θ4 = 0`) exactly at t2;
+//!   if a foot point comes closer to the ground than the toe clearance, a position actuator
+//!   (a temporary forward shift of the hip's set point, `pa3·sin(π·τ)`) is increased step by step
+//!   and swing2 repeated — the ground-stubbing recovery;
+//! - *swing3* (t2 → heel strike): the knee is locked straight (the locking impulse conserves the
+//!   thigh's generalized momentum), hip torque `F_θ3 = C·e^{−(t−t2)/τ}`, `C` found so that
+//!   `θ3` reaches the heel-strike value exactly at `t_swing`, which with eq. (3) puts the heel on
+//!   the ground.
+//!
+//! The foot is kinematic: the ankle angle θ5 and the toe bend θ6 are interpolated (C¹) between
+//! their toe-off and heel-strike values.
+use super::body::Body;
+use super::dynamics::{HipMotion, SwingModel};
+use super::foot::{smoothstep, FootPoints, FootShape};
+use super::integrate::{integrate, spectral_radius, stable_step};
+use super::shooting::solve_1d;
+use super::track::{Node, Track};
+use std::f64::consts::FRAC_PI_2;
+
+/// Everything that defines one swing phase.
+#[derive(Clone, Copy)]
+pub struct SwingSpec<'a> {
+    /// The double pendulum.
+    pub model: SwingModel,
+    /// The foot.
+    pub foot: FootShape,
+    /// The swing hip's motion (x from the stance ankle, y above the ground) at stance time t.
+    pub hip: &'a dyn Fn(f64) -> HipMotion,
+    /// Times where the hip's acceleration jumps (integration restarts there), s.
+    pub breakpoints: &'a [f64],
+    /// Toe-off, end of swing1, end of swing2, heel strike (stance time), s.
+    pub times: [f64; 4],
+    /// Thigh angle at heel strike (eq. 3), rad.
+    pub theta3_hs: f64,
+    /// Ankle angle θ5 at toe-off and at heel strike, rad.
+    pub theta5: [f64; 2],
+    /// Toe bend θ6 at toe-off, rad (0 at heel strike).
+    pub theta6_toe_off: f64,
+    /// Height of `a_max` above the higher end of the ankle curve, m.
+    pub ankle_lift: f64,
+    /// Decay time constants of the three subphases' exponential torques, s.
+    pub tau: [f64; 3],
+    /// Hip spring (N·m/rad) and damper (N·m·s/rad) of swing2.
+    pub hip_spring: [f64; 2],
+    /// Minimum clearance of the foot over the ground in swing2, m.
+    pub clearance: f64,
+    /// Largest integration step, s.
+    pub max_step: f64,
+}
+
+/// State at toe-off: `[θ3, θ4]` and rates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SwingStart {
+    /// `[θ3, θ4]`, rad.
+    pub q: [f64; 2],
+    /// `[θ̇3, θ̇4]`, rad/s.
+    pub qd: [f64; 2],
+}
+
+/// The ankle curve `P` of swing1: `y(x) = Σ c_i x^i`, x measured from the ankle at toe-off.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AnkleCurve {
+    /// Coefficients `c0..c4`.
+    pub c: [f64; 5],
+    /// Ankle x at toe-off (origin of x), m.
+    pub x0: f64,
+    /// `D`: the ankle's forward travel at t1, m.
+    pub d: f64,
+    /// `a0`, `a_max`, `a_min`, m.
+    pub heights: [f64; 3],
+}
+
+impl AnkleCurve {
+    /// Fits the five conditions `y(0) = a0, y(C) = a_max, y'(C) = 0, y(D) = a_min, y'(D) = 0`
+    /// with `C = 0.3·D` (§4.3).
+    pub fn fit(x0: f64, d: f64, a0: f64, a_max: f64, a_min: f64) -> Option<AnkleCurve> {
+        let c = 0.3 * d;
+        let m = nalgebra::Matrix4::new(
+            c,
+            c * c,
+            c.powi(3),
+            c.powi(4),
+            1.0,
+            2.0 * c,
+            3.0 * c * c,
+            4.0 * c.powi(3),
+            d,
+            d * d,
+            d.powi(3),
+            d.powi(4),
+            1.0,
+            2.0 * d,
+            3.0 * d * d,
+            4.0 * d.powi(3),
+        );
+        let rhs = nalgebra::Vector4::new(a_max - a0, 0.0, a_min - a0, 0.0);
+        let sol = m.lu().solve(&rhs)?;
+        Some(AnkleCurve { c: [a0, sol[0], sol[1], sol[2], sol[3]], x0, d, heights: [a0, a_max, a_min] })
+    }
+
+    /// `(y, dy/dx)` at ankle position `x` (absolute).
+    pub fn eval(&self, x: f64) -> (f64, f64) {
+        let u = x - self.x0;
+        let c = &self.c;
+        let y = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * c[4])));
+        let dy = c[1] + u * (2.0 * c[2] + u * (3.0 * c[3] + u * 4.0 * c[4]));
+        (y, dy)
+    }
+}
+
+/// Outcome of a simulated swing.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SwingRun {
+    /// The trajectory of `[θ3, θ4]`.
+    pub track: Track<2>,
+    /// Shooting iterations of swing1, swing2 (all recovery rounds), swing3.
+    pub iterations: [usize; 3],
+    /// Torque parameters `A`, `B`, `C` found.
+    pub params: [f64; 3],
+    /// Final position actuator of the stubbing recovery, rad (0 if not needed).
+    pub recovery: f64,
+    /// Recovery rounds used.
+    pub recovery_rounds: usize,
+    /// Lowest foot clearance over the swing after toe-off, m.
+    pub min_clearance: f64,
+    /// `θ3` error at t1 and at heel strike, `θ4` at t2, rad.
+    pub end_errors: [f64; 3],
+    /// The ankle curve.
+    pub curve: AnkleCurve,
+}
+
+const TOL: f64 = 1e-8;
+
+impl SwingSpec<'_> {
+    fn theta56(&self, t: f64) -> (f64, f64) {
+        let [t0, _, _, t3] = self.times;
+        let s = smoothstep((t - t0) / (t3 - t0));
+        (self.theta5[0] + (self.theta5[1] - self.theta5[0]) * s, self.theta6_toe_off * (1.0 - s))
+    }
+
+    /// Knee and ankle positions (ground frame) for angles `q` at time `t`.
+    pub fn joints(&self, t: f64, q: &[f64; 2]) -> ([f64; 2], [f64; 2]) {
+        let h = (self.hip)(t).pos;
+        let (k, a) = self.model.knee_ankle(q);
+        ([h[0] + k[0], h[1] + k[1]], [h[0] + a[0], h[1] + a[1]])
+    }
+
+    /// Foot sole points for angles `q` at time `t`.
+    pub fn foot_points(&self, t: f64, q: &[f64; 2]) -> FootPoints {
+        let (_, ankle) = self.joints(t, q);
+        let (t5, t6) = self.theta56(t);
+        let phi = t5 - FRAC_PI_2 - (q[0] + q[1]);
+        self.foot.points(ankle, phi, t6)
+    }
+
+    fn segments(&self, a: f64, b: f64) -> Vec<(f64, f64)> {
+        let mut cuts: Vec<f64> = self.breakpoints.iter().copied().filter(|&x| x > a && x < b).collect();
+        cuts.sort_by(f64::total_cmp);
+        let mut out = Vec::new();
+        let mut s = a;
+        for c in cuts {
+            out.push((s, c));
+            s = c;
+        }
+        out.push((s, b));
+        out
+    }
+
+    /// The ankle curve from the toe-off state.
+    pub fn curve(&self, start: &SwingStart, speed: f64) -> Result<AnkleCurve, String> {
+        let [t0, t1, _, _] = self.times;
+        let (_, a0) = self.joints(t0, &start.q);
+        // At t1 the thigh is at its heel-strike angle and the toe is under the knee.
+        let (t5, t6) = self.theta56(t1);
+        let mut th4 = 1.0;
+        for _ in 0..60 {
+            let q = [self.theta3_hs, th4];
+            let (k, _) = self.joints(t1, &q);
+            let p = self.foot_points(t1, &q);
+            let _ = (t5, t6);
+            let f = p.toe[0] - k[0];
+            let q2 = [self.theta3_hs, th4 + 1e-7];
+            let (k2, _) = self.joints(t1, &q2);
+            let f2 = self.foot_points(t1, &q2).toe[0] - k2[0];
+            let d = (f2 - f) / 1e-7;
+            if d == 0.0 {
+                break;
+            }
+            let step = (f / d).clamp(-0.3, 0.3);
+            th4 -= step;
+            if step.abs() < 1e-13 {
+                break;
+            }
+        }
+        let (_, a1) = self.joints(t1, &[self.theta3_hs, th4]);
+        let d = a1[0] - a0[0];
+        if !(d > 0.0) {
+            return Err(format!("the ankle would not move forward in swing1 (D = {d:.3} m)"));
+        }
+        let lift = self.ankle_lift / speed.max(0.5);
+        let a_max = a0[1].max(a1[1]) + lift;
+        AnkleCurve::fit(a0[0], d, a0[1], a_max, a1[1]).ok_or_else(|| "ankle curve is singular".to_string())
+    }
+
+    /// The knee angle that puts the ankle on the curve, by Newton from `guess`.
+    fn knee_on_curve(&self, t: f64, th3: f64, curve: &AnkleCurve, guess: f64) -> f64 {
+        let h = (self.hip)(t).pos;
+        let (l3, l4) = (self.model.l3, self.model.l4);
+        let k = [h[0] - l3 * th3.sin(), h[1] - l3 * th3.cos()];
+        let mut th4 = guess;
+        for _ in 0..30 {
+            let (s, c) = (th3 + th4).sin_cos();
+            let a = [k[0] - l4 * s, k[1] - l4 * c];
+            let (y, dy) = curve.eval(a[0]);
+            let f = a[1] - y;
+            let df = l4 * s + dy * l4 * c;
+            if df.abs() < 1e-12 {
+                break;
+            }
+            let step = (f / df).clamp(-0.2, 0.2);
+            th4 -= step;
+            if step.abs() < 1e-14 {
+                break;
+            }
+        }
+        th4
+    }
+
+    fn swing1(&self, start: &SwingStart, curve: &AnkleCurve, a: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
+        let [t0, t1, _, _] = self.times;
+        let tau = self.tau[0];
+        let mut cache = start.q[1];
+        let mut y = [start.q[0], start.qd[0]];
+        let mut rec = rec;
+        for (sa, sb) in self.segments(t0, t1) {
+            let mut f = |t: f64, y: &[f64; 2]| {
+                let th4 = self.knee_on_curve(t, y[0], curve, cache);
+                cache = th4;
+                let hip = (self.hip)(t);
+                let ft = a * (-(t - t0) / tau).exp();
+                let acc = self.model.accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+                [y[1], acc[0]]
+            };
+            if let Some(r) = rec.as_deref_mut() {
+                r.push(self.node1(sa, &y, curve, a));
+            }
+            let recording = rec.is_some();
+            let mut nodes: Vec<(f64, [f64; 2])> = Vec::new();
+            let mut obs = |_: f64, _: &[f64; 2], t1: f64, y1: &[f64; 2]| {
+                if recording {
+                    nodes.push((t1, *y1));
+                }
+            };
+            let no: Option<&mut fn(f64, &[f64; 2]) -> f64> = None;
+            let end = integrate(&mut f, sa, y, sb, h, no, &mut obs);
+            if let Some(r) = rec.as_deref_mut() {
+                for (t, yy) in nodes {
+                    r.push(self.node1(t, &yy, curve, a));
+                }
+            }
+            y = end.y;
+        }
+        y
+    }
+
+    fn node1(&self, t: f64, y: &[f64; 2], curve: &AnkleCurve, a: f64) -> Node<2> {
+        let [t0, ..] = self.times;
+        let g = |tt: f64, th3: f64| self.knee_on_curve(tt, th3, curve, 0.8);
+        let th4 = self.knee_on_curve(t, y[0], curve, 0.8);
+        let _ = g;
+        let eps = 1e-5;
+        let hip = (self.hip)(t);
+        let ft = a * (-(t - t0) / self.tau[0]).exp();
+        let acc = self.model.accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+        let th4p = self.knee_on_curve(t + eps, y[0] + eps * y[1], curve, th4);
+        let th4m = self.knee_on_curve(t - eps, y[0] - eps * y[1], curve, th4);
+        Node {
+            t,
+            q: [y[0], th4],
+            qd: [y[1], (th4p - th4m) / (2.0 * eps)],
+            qdd: [acc[0], (th4p - 2.0 * th4 + th4m) / (eps * eps)],
+        }
+    }
+
+    fn swing2(&self, y0: [f64; 4], b: f64, pa: f64, h: f64, rec: Option<&mut Track<2>>) -> ([f64; 4], f64) {
+        let [_, t1, t2, _] = self.times;
+        let [k3, c3] = self.hip_spring;
+        let tau = self.tau[1];
+        let th3_hs = self.theta3_hs;
+        let f = |t: f64, y: &[f64; 4]| {
+            let hip = (self.hip)(t);
+            let set = th3_hs - pa * (std::f64::consts::PI * (t - t1) / (t2 - t1)).sin();
+            let f3 = -k3 * (y[0] - set) - c3 * y[2];
+            let f4 = b * (-(t - t1) / tau).exp();
+            let acc = self.model.accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, f4], &hip.acc, false);
+            [y[2], y[3], acc[0], acc[1]]
+        };
+        let mut y = y0;
+        let mut lowest = f64::INFINITY;
+        let mut rec = rec;
+        for (sa, sb) in self.segments(t1, t2) {
+            if let Some(r) = rec.as_deref_mut() {
+                let d = f(sa, &y);
+                r.push(Node { t: sa, q: [y[0], y[1]], qd: [y[2], y[3]], qdd: [d[2], d[3]] });
+            }
+            let mut ff = f;
+            let mut obs = |_: f64, _: &[f64; 4], tt: f64, yy: &[f64; 4]| {
+                lowest = lowest.min(self.foot_points(tt, &[yy[0], yy[1]]).lowest());
+                if let Some(r) = rec.as_deref_mut() {
+                    let d = f(tt, yy);
+                    r.push(Node { t: tt, q: [yy[0], yy[1]], qd: [yy[2], yy[3]], qdd: [d[2], d[3]] });
+                }
+            };
+            let no: Option<&mut fn(f64, &[f64; 4]) -> f64> = None;
+            y = integrate(&mut ff, sa, y, sb, h, no, &mut obs).y;
+        }
+        (y, lowest)
+    }
+
+    fn swing3(&self, y0: [f64; 2], c: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
+        let [_, _, t2, t3] = self.times;
+        let tau = self.tau[2];
+        let f = |t: f64, y: &[f64; 2]| {
+            let hip = (self.hip)(t);
+            let ft = c * (-(t - t2) / tau).exp();
+            let acc = self.model.accel(&[y[0], 0.0], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+            [y[1], acc[0]]
+        };
+        let mut y = y0;
+        let mut rec = rec;
+        for (sa, sb) in self.segments(t2, t3) {
+            if let Some(r) = rec.as_deref_mut() {
+                let d = f(sa, &y);
+                r.push(Node { t: sa, q: [y[0], 0.0], qd: [y[1], 0.0], qdd: [d[1], 0.0] });
+            }
+            let mut ff = f;
+            let mut obs = |_: f64, _: &[f64; 2], tt: f64, yy: &[f64; 2]| {
+                if let Some(r) = rec.as_deref_mut() {
+                    let d = f(tt, yy);
+                    r.push(Node { t: tt, q: [yy[0], 0.0], qd: [yy[1], 0.0], qdd: [d[1], 0.0] });
+                }
+            };
+            let no: Option<&mut fn(f64, &[f64; 2]) -> f64> = None;
+            y = integrate(&mut ff, sa, y, sb, h, no, &mut obs).y;
+        }
+        y
+    }
+
+    /// Simulates the swing, finding `A`, `B` and `C` (from `guess`, the previous step's values).
+    pub fn solve(&self, start: &SwingStart, guess: [f64; 3], speed: f64) -> Result<SwingRun, String> {
+        let [t0, t1, t2, _] = self.times;
+        let curve = self.curve(start, speed)?;
+        // Stability bound from swing2's spring–damper (the stiffest subphase).
+        let mut jf = |t: f64, y: &[f64; 4]| {
+            let hip = (self.hip)(t);
+            let f3 = -self.hip_spring[0] * y[0] - self.hip_spring[1] * y[2];
+            let acc = self.model.accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, 0.0], &hip.acc, false);
+            [y[2], y[3], acc[0], acc[1]]
+        };
+        let h = stable_step(spectral_radius(&mut jf, t1, &[start.q[0], start.q[1], 0.0, 0.0]), self.max_step);
+        let scale = self.model.mass_matrix(&[0.0, 0.0])[0][0];
+        // swing1
+        let s1 = solve_1d(
+            |a| self.swing1(start, &curve, a, h, None)[0] - self.theta3_hs,
+            guess[0],
+            0.5 * scale,
+            TOL,
+            60,
+        )
+        .map_err(|e| format!("swing1: {e}"))?;
+        let mut track = Track::default();
+        let y1 = self.swing1(start, &curve, s1.x[0], h, Some(&mut track));
+        let last = *track.nodes.last().ok_or("swing1 recorded nothing")?;
+        let y2_0 = [y1[0], last.q[1], y1[1], last.qd[1]];
+        // swing2 with the ground-stubbing recovery.
+        let mut pa = 0.0;
+        let mut rounds = 0;
+        let mut it2 = 0;
+        let mut b_guess = guess[1];
+        let (s2, lowest) = loop {
+            let s2 = solve_1d(|b| self.swing2(y2_0, b, pa, h, None).0[1], b_guess, 0.2 * scale, TOL, 60)
+                .map_err(|e| format!("swing2: {e}"))?;
+            it2 += s2.iterations;
+            let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
+            if lowest >= self.clearance || rounds >= 40 {
+                break (s2, lowest);
+            }
+            rounds += 1;
+            pa += 0.01;
+            b_guess = s2.x[0];
+        };
+        let before = track.nodes.len();
+        let (y2, _) = self.swing2(y2_0, s2.x[0], pa, h, Some(&mut track));
+        let _ = before;
+        // Knee lock at t2: the knee's impulse leaves the thigh's generalized momentum unchanged.
+        let m = self.model.mass_matrix(&[y2[0], y2[1]]);
+        let th3d = (m[0][0] * y2[2] + m[0][1] * y2[3]) / self.model.mass_matrix(&[y2[0], 0.0])[0][0];
+        let y3_0 = [y2[0], th3d];
+        let s3 = solve_1d(|c| self.swing3(y3_0, c, h, None)[0] - self.theta3_hs, guess[2], 0.2 * scale, TOL, 60)
+            .map_err(|e| format!("swing3: {e}"))?;
+        let y3 = self.swing3(y3_0, s3.x[0], h, Some(&mut track));
+        // Clearance over the whole swing (after the first 5 % of it, where the toe is leaving).
+        let t_check = t0 + 0.05 * (t2 - t0);
+        let min_clearance = track
+            .nodes
+            .iter()
+            .filter(|n| n.t >= t_check && n.t < self.times[3] - 1e-9)
+            .map(|n| self.foot_points(n.t, &n.q).lowest())
+            .fold(f64::INFINITY, f64::min);
+        let _ = lowest;
+        Ok(SwingRun {
+            iterations: [s1.iterations, it2, s3.iterations],
+            params: [s1.x[0], s2.x[0], s3.x[0]],
+            recovery: pa,
+            recovery_rounds: rounds,
+            min_clearance,
+            end_errors: [y1[0] - self.theta3_hs, y2[1], y3[0] - self.theta3_hs],
+            curve,
+            track,
+        })
+    }
+}
+
+/// The body's swing model and foot.
+pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
+    (SwingModel::new(body), FootShape::new(body))
+}
