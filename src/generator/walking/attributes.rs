@@ -149,8 +149,10 @@ attributes! {
     /// Ankle angle θ5 at heel strike (eq. 3): angle between the shank and the sole, 90° neutral,
     /// larger in dorsiflexion.
     ankle_heel_strike_deg: 90.0, [70.0, 115.0], "deg";
-    /// Ankle angle θ5 at toe-off (end of the meta-off period); below 90° is plantar flexion.
-    ankle_toe_off_deg: 72.0, [50.0, 110.0], "deg";
+    /// Ankle angle θ5 of the swing foot at the end of swing1 (dorsiflexed for toe clearance).
+    ankle_mid_swing_deg: 100.0, [70.0, 125.0], "deg";
+    /// Knee flexion at toe-off, reached through the meta-off period (θ5 at toe-off follows).
+    knee_toe_off_deg: 35.0, [0.0, 80.0], "deg";
     /// Ankle dorsiflexion limit θ5 that ends the normal period and starts heel-off (§4.2).
     ankle_dorsiflexion_max_deg: 100.0, [90.0, 125.0], "deg";
     /// Metatarsal (toe) joint limit θ6 that ends heel-off and starts meta-off (§4.2).

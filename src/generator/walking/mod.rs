@@ -1,8 +1,10 @@
 //! KLAW: goal-directed, dynamic walking (Bruderlin & Calvert 1989).
 pub mod attributes;
 pub mod body;
+pub mod collision;
 pub mod dynamics;
 pub mod foot;
+pub mod generate;
 pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
@@ -10,3 +12,4 @@ pub mod shooting;
 pub mod stance;
 pub mod swing;
 pub mod track;
+pub mod virtual_leg;

@@ -40,8 +40,8 @@ pub struct SwingSpec<'a> {
     pub times: [f64; 4],
     /// Thigh angle at heel strike (eq. 3), rad.
     pub theta3_hs: f64,
-    /// Ankle angle θ5 at toe-off and at heel strike, rad.
-    pub theta5: [f64; 2],
+    /// Ankle angle θ5 at toe-off, at the end of swing1 and at heel strike, rad.
+    pub theta5: [f64; 3],
     /// Toe bend θ6 at toe-off, rad (0 at heel strike).
     pub theta6_toe_off: f64,
     /// Height of `a_max` above the higher end of the ankle curve, m.
@@ -123,8 +123,9 @@ pub struct SwingRun {
     pub track: Track<2>,
     /// Shooting iterations of swing1, swing2 (all recovery rounds), swing3.
     pub iterations: [usize; 3],
-    /// Torque parameters `A`, `B`, `C` found.
-    pub params: [f64; 3],
+    /// Torque parameters `A`, `B`, `C` found, and the swing1 recovery's lift of the ankle
+    /// curve (m).
+    pub params: [f64; 4],
     /// Final position actuator of the stubbing recovery, rad (0 if not needed).
     pub recovery: f64,
     /// Recovery rounds used.
@@ -140,10 +141,15 @@ pub struct SwingRun {
 const TOL: f64 = 1e-8;
 
 impl SwingSpec<'_> {
-    fn theta56(&self, t: f64) -> (f64, f64) {
-        let [t0, _, _, t3] = self.times;
-        let s = smoothstep((t - t0) / (t3 - t0));
-        (self.theta5[0] + (self.theta5[1] - self.theta5[0]) * s, self.theta6_toe_off * (1.0 - s))
+    /// θ5 and θ6 of the kinematic swing foot at `t`: θ5 from its toe-off value to its mid-swing
+    /// value at t1 (dorsiflexion for toe clearance), then to its heel-strike value; θ6 from its
+    /// toe-off value to 0 at t1. Each piece is a C¹ blend.
+    pub fn theta56(&self, t: f64) -> (f64, f64) {
+        let [t0, t1, _, t3] = self.times;
+        let [to, mid, hs] = self.theta5;
+        let s1 = smoothstep((t - t0) / (t1 - t0));
+        let th5 = if t <= t1 { to + (mid - to) * s1 } else { mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1)) };
+        (th5, self.theta6_toe_off * (1.0 - s1))
     }
 
     /// Knee and ankle positions (ground frame) for angles `q` at time `t`.
@@ -164,6 +170,7 @@ impl SwingSpec<'_> {
     fn segments(&self, a: f64, b: f64) -> Vec<(f64, f64)> {
         let mut cuts: Vec<f64> = self.breakpoints.iter().copied().filter(|&x| x > a && x < b).collect();
         cuts.sort_by(f64::total_cmp);
+        cuts.dedup_by(|x, y| (*x - *y).abs() < 1e-12);
         let mut out = Vec::new();
         let mut s = a;
         for c in cuts {
@@ -175,17 +182,15 @@ impl SwingSpec<'_> {
     }
 
     /// The ankle curve from the toe-off state.
-    pub fn curve(&self, start: &SwingStart, speed: f64) -> Result<AnkleCurve, String> {
+    pub fn curve(&self, start: &SwingStart, speed: f64, extra_lift: f64) -> Result<AnkleCurve, String> {
         let [t0, t1, _, _] = self.times;
         let (_, a0) = self.joints(t0, &start.q);
         // At t1 the thigh is at its heel-strike angle and the toe is under the knee.
-        let (t5, t6) = self.theta56(t1);
         let mut th4 = 1.0;
         for _ in 0..60 {
             let q = [self.theta3_hs, th4];
             let (k, _) = self.joints(t1, &q);
             let p = self.foot_points(t1, &q);
-            let _ = (t5, t6);
             let f = p.toe[0] - k[0];
             let q2 = [self.theta3_hs, th4 + 1e-7];
             let (k2, _) = self.joints(t1, &q2);
@@ -200,14 +205,32 @@ impl SwingSpec<'_> {
                 break;
             }
         }
+        // If the toe would come closer to the ground than the clearance there, flex the knee
+        // further until it clears (the ankle then sits higher and further back).
+        if self.foot_points(t1, &[self.theta3_hs, th4]).toe[1] < self.clearance {
+            let toe_y = |k4: f64| self.foot_points(t1, &[self.theta3_hs, k4]).toe[1] - self.clearance;
+            let (mut lo, mut hi) = (th4, th4 + 1.5);
+            if toe_y(hi) > 0.0 {
+                for _ in 0..60 {
+                    let m = 0.5 * (lo + hi);
+                    if toe_y(m) > 0.0 {
+                        hi = m;
+                    } else {
+                        lo = m;
+                    }
+                }
+                th4 = hi;
+            }
+        }
         let (_, a1) = self.joints(t1, &[self.theta3_hs, th4]);
         let d = a1[0] - a0[0];
         if !(d > 0.0) {
             return Err(format!("the ankle would not move forward in swing1 (D = {d:.3} m)"));
         }
+        let a_min = a1[1] + extra_lift;
         let lift = self.ankle_lift / speed.max(0.5);
-        let a_max = a0[1].max(a1[1]) + lift;
-        AnkleCurve::fit(a0[0], d, a0[1], a_max, a1[1]).ok_or_else(|| "ankle curve is singular".to_string())
+        let a_max = a0[1].max(a_min) + lift;
+        AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min).ok_or_else(|| "ankle curve is singular".to_string())
     }
 
     /// The knee angle that puts the ankle on the curve, by Newton from `guess`.
@@ -234,9 +257,8 @@ impl SwingSpec<'_> {
         th4
     }
 
-    fn swing1(&self, start: &SwingStart, curve: &AnkleCurve, a: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
+    fn swing1(&self, start: &SwingStart, curve: &AnkleCurve, a: f64, tau: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
         let [t0, t1, _, _] = self.times;
-        let tau = self.tau[0];
         let mut cache = start.q[1];
         let mut y = [start.q[0], start.qd[0]];
         let mut rec = rec;
@@ -250,7 +272,7 @@ impl SwingSpec<'_> {
                 [y[1], acc[0]]
             };
             if let Some(r) = rec.as_deref_mut() {
-                r.push(self.node1(sa, &y, curve, a));
+                r.push(self.node1(sa, &y, curve, a, tau));
             }
             let recording = rec.is_some();
             let mut nodes: Vec<(f64, [f64; 2])> = Vec::new();
@@ -263,7 +285,7 @@ impl SwingSpec<'_> {
             let end = integrate(&mut f, sa, y, sb, h, no, &mut obs);
             if let Some(r) = rec.as_deref_mut() {
                 for (t, yy) in nodes {
-                    r.push(self.node1(t, &yy, curve, a));
+                    r.push(self.node1(t, &yy, curve, a, tau));
                 }
             }
             y = end.y;
@@ -271,14 +293,12 @@ impl SwingSpec<'_> {
         y
     }
 
-    fn node1(&self, t: f64, y: &[f64; 2], curve: &AnkleCurve, a: f64) -> Node<2> {
+    fn node1(&self, t: f64, y: &[f64; 2], curve: &AnkleCurve, a: f64, tau: f64) -> Node<2> {
         let [t0, ..] = self.times;
-        let g = |tt: f64, th3: f64| self.knee_on_curve(tt, th3, curve, 0.8);
         let th4 = self.knee_on_curve(t, y[0], curve, 0.8);
-        let _ = g;
         let eps = 1e-5;
         let hip = (self.hip)(t);
-        let ft = a * (-(t - t0) / self.tau[0]).exp();
+        let ft = a * (-(t - t0) / tau).exp();
         let acc = self.model.accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
         let th4p = self.knee_on_curve(t + eps, y[0] + eps * y[1], curve, th4);
         let th4m = self.knee_on_curve(t - eps, y[0] - eps * y[1], curve, th4);
@@ -355,9 +375,8 @@ impl SwingSpec<'_> {
     }
 
     /// Simulates the swing, finding `A`, `B` and `C` (from `guess`, the previous step's values).
-    pub fn solve(&self, start: &SwingStart, guess: [f64; 3], speed: f64) -> Result<SwingRun, String> {
+    pub fn solve(&self, start: &SwingStart, guess: [f64; 4], speed: f64) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
-        let curve = self.curve(start, speed)?;
         // Stability bound from swing2's spring–damper (the stiffest subphase).
         let mut jf = |t: f64, y: &[f64; 4]| {
             let hip = (self.hip)(t);
@@ -367,17 +386,48 @@ impl SwingSpec<'_> {
         };
         let h = stable_step(spectral_radius(&mut jf, t1, &[start.q[0], start.q[1], 0.0, 0.0]), self.max_step);
         let scale = self.model.mass_matrix(&[0.0, 0.0])[0][0];
-        // swing1
-        let s1 = solve_1d(
-            |a| self.swing1(start, &curve, a, h, None)[0] - self.theta3_hs,
-            guess[0],
-            0.5 * scale,
-            TOL,
-            60,
-        )
-        .map_err(|e| format!("swing1: {e}"))?;
-        let mut track = Track::default();
-        let y1 = self.swing1(start, &curve, s1.x[0], h, Some(&mut track));
+        // swing1: the torque's magnitude so that the thigh reaches its heel-strike angle at t1.
+        // If the foot comes closer to the ground than the clearance, the end of the ankle curve
+        // (a_min, and with it a_max) is raised by the deficit and swing1 repeated (the swing2
+        // recovery of §4.3, applied to swing1's kinematic ankle path).
+        let tau1 = self.tau[0];
+        let mut extra = guess[3].max(0.0);
+        let mut it1 = 0;
+        let mut a_guess = guess[0];
+        let mut lift_rounds = 0;
+        let (a1, curve, mut track, y1) = loop {
+            let curve = self.curve(start, speed, extra)?;
+            let s1 = solve_1d(
+                |a| self.swing1(start, &curve, a, tau1, h, None)[0] - self.theta3_hs,
+                a_guess,
+                0.5 * scale,
+                TOL,
+                60,
+            )
+            .map_err(|e| format!("swing1: {e}"))?;
+            it1 += s1.iterations;
+            let mut track = Track::default();
+            let y1 = self.swing1(start, &curve, s1.x[0], tau1, h, Some(&mut track));
+            // The toe is leaving the ground at toe-off: the clearance applies from 30 % of
+            // swing1 on; before that the foot must merely stay above the ground.
+            let t_check = t0 + 0.3 * (t1 - t0);
+            let mut deficit: f64 = 0.0;
+            for n in track.nodes.iter().filter(|n| n.t > t0) {
+                let low = self.foot_points(n.t, &n.q).lowest();
+                let need = if n.t >= t_check { self.clearance } else { -5e-4 };
+                deficit = deficit.max(need - low);
+            }
+            if std::env::var("KLAW_DUMP2").is_ok() {
+                let worst = track.nodes.iter().filter(|n| n.t > t0).map(|n| (n.t, self.foot_points(n.t, &n.q))).min_by(|a, b| a.1.lowest().total_cmp(&b.1.lowest()));
+                eprintln!("round {lift_rounds} extra {extra:.4} deficit {deficit:.5} worst {:?} t0 {t0} t1 {t1}", worst);
+            }
+            if deficit <= 0.0 || lift_rounds >= 10 {
+                break (s1.x[0], curve, track, y1);
+            }
+            extra += deficit + 1e-3;
+            lift_rounds += 1;
+            a_guess = s1.x[0];
+        };
         let last = *track.nodes.last().ok_or("swing1 recorded nothing")?;
         let y2_0 = [y1[0], last.q[1], y1[1], last.qd[1]];
         // swing2 with the ground-stubbing recovery.
@@ -390,11 +440,11 @@ impl SwingSpec<'_> {
                 .map_err(|e| format!("swing2: {e}"))?;
             it2 += s2.iterations;
             let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
-            if lowest >= self.clearance || rounds >= 40 {
+            if lowest >= self.clearance || rounds >= 20 {
                 break (s2, lowest);
             }
             rounds += 1;
-            pa += 0.01;
+            pa += 0.02;
             b_guess = s2.x[0];
         };
         let before = track.nodes.len();
@@ -407,20 +457,20 @@ impl SwingSpec<'_> {
         let s3 = solve_1d(|c| self.swing3(y3_0, c, h, None)[0] - self.theta3_hs, guess[2], 0.2 * scale, TOL, 60)
             .map_err(|e| format!("swing3: {e}"))?;
         let y3 = self.swing3(y3_0, s3.x[0], h, Some(&mut track));
-        // Clearance over the whole swing (after the first 5 % of it, where the toe is leaving).
-        let t_check = t0 + 0.05 * (t2 - t0);
+        // Clearance over the swing from 30 % of swing1 on (the toe is leaving before that).
+        let t_check = t0 + 0.3 * (t1 - t0);
         let min_clearance = track
             .nodes
             .iter()
-            .filter(|n| n.t >= t_check && n.t < self.times[3] - 1e-9)
+            .filter(|n| n.t >= t_check && n.t <= t2)
             .map(|n| self.foot_points(n.t, &n.q).lowest())
             .fold(f64::INFINITY, f64::min);
         let _ = lowest;
         Ok(SwingRun {
-            iterations: [s1.iterations, it2, s3.iterations],
-            params: [s1.x[0], s2.x[0], s3.x[0]],
+            iterations: [it1, it2, s3.iterations],
+            params: [a1, s2.x[0], s3.x[0], extra],
             recovery: pa,
-            recovery_rounds: rounds,
+            recovery_rounds: rounds + lift_rounds,
             min_clearance,
             end_errors: [y1[0] - self.theta3_hs, y2[1], y3[0] - self.theta3_hs],
             curve,
@@ -432,4 +482,24 @@ impl SwingSpec<'_> {
 /// The body's swing model and foot.
 pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
     (SwingModel::new(body), FootShape::new(body))
+}
+
+impl SwingRun {
+    /// Debug print of the trajectory (θ3, θ4 in degrees) every `every` nodes.
+    #[doc(hidden)]
+    pub fn dump(&self, spec: &SwingSpec<'_>, every: usize) -> String {
+        let mut s = String::new();
+        for (i, n) in self.track.nodes.iter().enumerate() {
+            if i % every == 0 {
+                let p = spec.foot_points(n.t, &n.q);
+                let (k, an) = spec.joints(n.t, &n.q);
+                let h = (spec.hip)(n.t);
+                s += &format!(
+                    "t {:.3} th3 {:7.2} th4 {:7.2} hip ({:.3},{:.3}) knee ({:.3},{:.3}) ankle ({:.3},{:.3}) heel {:.3} toe {:.3}\n",
+                    n.t, n.q[0].to_degrees(), n.q[1].to_degrees(), h.pos[0], h.pos[1], k[0], k[1], an[0], an[1], p.heel[1], p.toe[1]
+                );
+            }
+        }
+        s
+    }
 }

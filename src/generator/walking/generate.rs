@@ -1,0 +1,652 @@
+//! The walk, step by step (§2.4): for each step the high level is executed first (step
+//! constraints), then the stance phase is simulated, the determinants of gait are applied to the
+//! pelvis, the trailing leg's stance is completed kinematically through the double support, the
+//! swing leg is simulated from toe-off to heel strike, and heel strike (a collision) gives the
+//! next stance phase its initial conditions. Finally every frame of the [`Motion`] is assembled
+//! from the recorded trajectories: pelvis, virtual stance leg, swing leg, kinematic feet, spine
+//! and arms.
+use super::attributes::WalkAttributes;
+use super::body::Body;
+use super::collision::{self, SwingAtImpact};
+use super::dynamics::{HipMotion, StanceModel};
+use super::foot::{smoothstep, FootShape};
+use super::high_level::{heel_strike, phase_times, HeelStrike, Locomotion, PhaseTimes, WalkRelations};
+use super::stance::{StanceRun, StanceSpec, StanceStart};
+use super::swing::{SwingRun, SwingSpec, SwingStart};
+use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
+use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
+use crate::generator::ik::leg_ik;
+use crate::generator::motion::{Motion, MotionMetadata};
+use crate::generator::skeleton::{Euler, Joint, Skeleton};
+use crate::generator::GenerateError;
+use glam::{DQuat, DVec3};
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// How a walk is to be generated (besides its steps).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkOptions {
+    /// Body height, m.
+    pub height_m: f64,
+    /// Body mass, kg.
+    pub mass_kg: f64,
+    /// Locomotion attributes.
+    pub attributes: WalkAttributes,
+    /// The walking relations (published or fitted).
+    pub relations: WalkRelations,
+    /// Output frame rate, frames/s.
+    pub fps: f64,
+    /// Start from standing (the first step is a half step from rest).
+    pub start_from_rest: bool,
+    /// End standing (a last half step, then the trailing foot is brought alongside).
+    pub stop: bool,
+}
+
+impl Default for WalkOptions {
+    fn default() -> Self {
+        WalkOptions {
+            height_m: 1.8,
+            mass_kg: 75.0,
+            attributes: WalkAttributes::default(),
+            relations: WalkRelations::PUBLISHED,
+            fps: 100.0,
+            start_from_rest: false,
+            stop: false,
+        }
+    }
+}
+
+/// What happened in one step: its constraints, the shooting effort and how well each phase met
+/// its final conditions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport {
+    /// Step number (0-based).
+    pub index: usize,
+    /// The stance leg.
+    pub stance_side: Side,
+    /// Start time (heel strike of the stance leg), s.
+    pub start_s: f64,
+    /// Commanded step length, m.
+    pub step_length_m: f64,
+    /// Commanded step frequency, steps/min.
+    pub step_freq_steps_per_min: f64,
+    /// Phase durations.
+    pub times: PhaseTimes,
+    /// Shooting simulations: stance, swing1, swing2, swing3.
+    pub iterations: [usize; 4],
+    /// Force parameters: stance `F_θ1` magnitude (N·m), extension amplitude `P` (m), swing
+    /// torque amplitudes `A`, `B`, `C` (N·m).
+    pub forces: [f64; 5],
+    /// Final-condition errors: stance `w` (m), stance `θ1`, `θ3` at t1, `θ4` at t2, `θ3` at
+    /// heel strike (rad).
+    pub errors: [f64; 5],
+    /// Rounds of the swing2 ground-stubbing recovery.
+    pub recovery_rounds: usize,
+    /// Lowest swing-foot clearance, m.
+    pub min_clearance_m: f64,
+    /// When the stance leg was locked / passed the vertical, s from the step's start.
+    pub lock_s: Option<f64>,
+}
+
+/// The report of a generated walk.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct WalkReport {
+    /// One entry per dynamic step.
+    pub steps: Vec<StepReport>,
+    /// Notes (start, stop, recoveries).
+    pub notes: Vec<String>,
+}
+
+impl WalkReport {
+    /// Total shooting simulations per phase kind: stance, swing1, swing2, swing3.
+    pub fn total_iterations(&self) -> [usize; 4] {
+        let mut t = [0; 4];
+        for s in &self.steps {
+            for i in 0..4 {
+                t[i] += s.iterations[i];
+            }
+        }
+        t
+    }
+}
+
+/// The pelvic determinants of gait during one step (§4.2), as functions of the time since the
+/// step's heel strike: rotation ψ (the swing hip ahead of the stance hip; −ψmax at the start,
+/// +ψmax at heel strike), list λ (swing side down; 0 at heel strike, maximal at mid-step),
+/// lateral displacement toward the stance foot (0 at heel strike). The paper interpolates them
+/// linearly between their boundary values; the swing hip's *acceleration* drives the swing
+/// dynamics, which a piecewise-linear path would make impulsive at the knots, so a half-cosine
+/// (C¹, same boundary values) is used instead.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Determinants {
+    /// Step duration, s.
+    pub duration: f64,
+    /// Maximal rotation, rad.
+    pub rotation: f64,
+    /// Maximal list, rad.
+    pub list: f64,
+    /// Maximal lateral displacement, m.
+    pub lateral: f64,
+    /// Half the pelvis width, m.
+    pub half_width: f64,
+    /// The swing side.
+    pub swing: Side,
+    /// First step from rest (rotation starts at 0).
+    pub from_rest: bool,
+    /// Last step to rest (rotation ends at 0).
+    pub to_rest: bool,
+}
+
+impl Determinants {
+    fn side_sign(s: Side) -> f64 {
+        match s {
+            Side::Left => -1.0,
+            Side::Right => 1.0,
+        }
+    }
+    /// ψ(t).
+    pub fn rotation_at(&self, t: f64) -> f64 {
+        let c = (PI * (t / self.duration).clamp(0.0, 1.0)).cos();
+        let (a, b) = (if self.from_rest { 0.0 } else { -self.rotation }, if self.to_rest { 0.0 } else { self.rotation });
+        a + (b - a) * 0.5 * (1.0 - c)
+    }
+    /// λ(t).
+    pub fn list_at(&self, t: f64) -> f64 {
+        self.list * (PI * (t / self.duration).clamp(0.0, 1.0)).sin().powi(2)
+    }
+    /// Lateral position of the pelvis centre (toward the stance foot), m.
+    pub fn lateral_at(&self, t: f64) -> f64 {
+        -Determinants::side_sign(self.swing) * self.lateral * (PI * (t / self.duration).clamp(0.0, 1.0)).sin()
+    }
+    /// Pelvis orientation (figure convention) at `t`.
+    pub fn pelvis(&self, t: f64) -> DQuat {
+        let s = Determinants::side_sign(self.swing);
+        Euler::new(0.0, s * self.list_at(t), s * self.rotation_at(t)).to_quat()
+    }
+    /// Offset of the swing hip from the pelvis centre, m.
+    pub fn swing_offset(&self, t: f64) -> DVec3 {
+        self.pelvis(t) * DVec3::new(0.0, 0.0, Determinants::side_sign(self.swing) * self.half_width)
+    }
+    /// Swing hip minus the dynamic hip in the sagittal plane `(dx, dy)` (the stance hip is at
+    /// `(−dx_offset, 0)`; see [`Determinants::swing_offset`]).
+    pub fn swing_hip_offset(&self, t: f64) -> [f64; 2] {
+        let o = self.swing_offset(t);
+        [o.x, 2.0 * o.y]
+    }
+}
+
+struct StepData {
+    side: Side,
+    start: f64,
+    loc: Locomotion,
+    times: PhaseTimes,
+    hs: HeelStrike,
+    ankle_x: f64,
+    det: Determinants,
+    stance: StanceRun,
+    swing: SwingRun,
+    swing_theta5: [f64; 3],
+    swing_theta6: f64,
+    swing_times: [f64; 4],
+    /// Virtual-leg roll samples of the stance leg over the step (time from step start, ρ).
+    stance_rho: Vec<(f64, f64)>,
+    stance_leg: VirtualLeg,
+    /// Trailing leg over the double support.
+    trail_rho: Vec<(f64, f64)>,
+    trail_leg: VirtualLeg,
+}
+
+fn interp_rho(samples: &[(f64, f64)], t: f64) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    let k = samples.partition_point(|s| s.0 <= t);
+    if k == 0 {
+        return samples[0].1;
+    }
+    if k >= samples.len() {
+        return samples[samples.len() - 1].1;
+    }
+    let (a, b) = (samples[k - 1], samples[k]);
+    if b.0 == a.0 {
+        return b.1;
+    }
+    a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0)
+}
+
+fn num_err(stage: String, message: String) -> GenerateError {
+    GenerateError::Numerical { stage, message }
+}
+
+fn side_z(side: Side, a: &WalkAttributes) -> f64 {
+    match side {
+        Side::Left => -0.5 * a.stride_width_m,
+        Side::Right => 0.5 * a.stride_width_m,
+    }
+}
+
+/// Generates a walk of the given steps (complete locomotion parameters, one per step).
+pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion, WalkReport), GenerateError> {
+    let a = &opt.attributes;
+    a.validate()?;
+    let skeleton = Skeleton::from_height(opt.height_m, opt.mass_kg)?;
+    let body = Body::new(skeleton.anthropometry());
+    if steps.is_empty() {
+        return Err(GenerateError::Parameter {
+            name: "steps".into(),
+            value: 0.0,
+            message: "a walk needs at least one step; give a longer duration".into(),
+        });
+    }
+    let model = StanceModel::new(&body);
+    let foot = FootShape::new(&body);
+    let g = model.g;
+    let k_w = a.leg_stiffness * body.mass_kg * g / body.l1;
+    let ieff = body.i2 + body.m2 * body.r2 * body.r2;
+    let om2 = 2.0 * PI * a.trunk_freq_hz;
+    let swing_model = super::dynamics::SwingModel::new(&body);
+    let m33 = swing_model.mass_matrix(&[0.0, 0.0])[0][0];
+    let om3 = 2.0 * PI * a.swing_hip_freq_hz;
+    let half_width = 0.5 * body.l0;
+    let ahead = half_width * a.pelvic_rotation_deg.to_radians().sin();
+    let theta5_hs = a.ankle_heel_strike_deg.to_radians();
+
+    let mut report = WalkReport::default();
+    let mut data: Vec<StepData> = Vec::with_capacity(steps.len());
+    let mut ankle_x = [0.0f64; 2]; // [left, right] flat-ankle x
+    let idx = |s: Side| match s {
+        Side::Left => 0,
+        Side::Right => 1,
+    };
+    let mut stance_side = Side::Left;
+    let mut stance_start = StanceStart { q: [body.l1, 0.0, a.trunk_lean_deg.to_radians()], qd: [0.0; 3] };
+    let mut from_rest = opt.start_from_rest;
+    if !from_rest {
+        // A steady start: the state a previous identical step would leave (approximated from
+        // eq. 3 and the speed; the first step's shooting absorbs the difference).
+        let l = &steps[0];
+        let hs = heel_strike(&body, l.step_length_m, theta5_hs, ahead)?;
+        let th = -hs.theta1;
+        let v = l.speed_m_per_s;
+        stance_start = StanceStart {
+            q: [hs.w, th, a.trunk_lean_deg.to_radians()],
+            qd: [v * th.sin(), v * th.cos() / hs.w, 0.0],
+        };
+        ankle_x = [0.0, -l.step_length_m];
+    }
+    // The trailing leg's virtual-leg state.
+    let mk_leg = |flat_x: f64, period: FootPeriod, rho: f64| VirtualLeg {
+        foot,
+        l3: body.l3,
+        l4: body.l4,
+        flat_ankle: [flat_x, body.l9],
+        theta5_max: a.ankle_dorsiflexion_max_deg.to_radians(),
+        theta6_max: a.metatarsal_max_deg.to_radians(),
+        knee_toe_off: a.knee_toe_off_deg.to_radians(),
+        toe_off_time: 0.0,
+        period,
+        rho,
+        meta_start: None,
+        transitions: [None; 3],
+    };
+    let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
+    let mut trailing_clock = 0.0;
+    if !from_rest {
+        // Put the trailing foot where the steady step would have it at heel strike: rolled so the
+        // leg reaches the hip.
+        trailing.period = FootPeriod::HeelOff;
+    }
+    let mut stance_guess = [0.0, 0.0];
+    let mut swing_guess = [0.0, 0.0, 0.0, 0.0];
+    let mut t_global = 0.0;
+    let mut prev_hs_pitch = if from_rest { 0.0 } else { heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch };
+    let n = steps.len();
+    for (k, l) in steps.iter().enumerate() {
+        let stage = |what: &str| format!("step {k} ({} stance), {what}", stance_side);
+        let swing_side = stance_side.opposite();
+        let to_rest = opt.stop && k + 1 == n;
+        let times = phase_times(l.step_freq_steps_per_min, &opt.relations);
+        let t_step = times.step;
+        let det = Determinants {
+            duration: t_step,
+            rotation: a.pelvic_rotation_deg.to_radians(),
+            list: a.pelvic_list_deg.to_radians(),
+            lateral: a.lateral_displacement_m,
+            half_width,
+            swing: swing_side,
+            from_rest,
+            to_rest,
+        };
+        let hs = heel_strike(&body, l.step_length_m, theta5_hs, if to_rest { 0.0 } else { ahead })?;
+        // 1. Stance.
+        let spec = StanceSpec {
+            model,
+            l1: body.l1,
+            k_w,
+            v_w: 2.0 * a.leg_damping * (k_w * body.m2).sqrt(),
+            k2: ieff * om2 * om2 + body.m2 * g * body.r2,
+            c2: 2.0 * a.trunk_damping * ieff * om2,
+            theta2_ref: a.trunk_lean_deg.to_radians(),
+            duration: t_step,
+            torque_off: a.hip_torque_off * t_step,
+            monitor_gain: 20.0,
+            target: [hs.w, hs.theta1],
+            max_step: a.max_step_s,
+        };
+        let (st_solved, st_run) =
+            spec.solve(&stance_start, stance_guess).map_err(|e| num_err(stage("stance shooting"), e))?;
+        stance_guess = st_solved.x;
+        let ax = ankle_x[idx(stance_side)];
+        let track = st_run.track.clone();
+        let dyn_hip = move |t: f64| -> HipMotion {
+            let (q, qd, qdd) = track.at(t);
+            let mut h = StanceModel::hip(&q, &qd, &qdd);
+            h.pos[0] += ax;
+            h.pos[1] += body.l9;
+            h
+        };
+        let swing_hip = |t: f64| -> HipMotion {
+            let mut h = dyn_hip(t);
+            let e = 1e-4;
+            let o = det.swing_hip_offset(t);
+            let op = det.swing_hip_offset(t + e);
+            let om = det.swing_hip_offset(t - e);
+            for i in 0..2 {
+                h.pos[i] += o[i];
+                h.vel[i] += (op[i] - om[i]) / (2.0 * e);
+                h.acc[i] += (op[i] - 2.0 * o[i] + om[i]) / (e * e);
+            }
+            h
+        };
+        let stance_hip = |t: f64| -> ([f64; 2], f64) {
+            let h = dyn_hip(t);
+            let o = det.swing_offset(t);
+            let z_c = det.lateral_at(t);
+            ([h.pos[0] - o.x, h.pos[1]], z_c - o.z)
+        };
+        let swing_hip3 = |t: f64| -> ([f64; 2], f64) {
+            let h = swing_hip(t);
+            let o = det.swing_offset(t);
+            (h.pos, det.lateral_at(t) + o.z)
+        };
+        // 2. The trailing leg completes its stance through the double support.
+        let dt_v = 1e-3;
+        let t_ds = if from_rest { times.double_support } else { times.double_support };
+        trailing.toe_off_time = trailing_clock + t_ds;
+        let mut trail_rho = Vec::new();
+        let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
+        let zf_w = side_z(swing_side, a);
+        let mut trail_poses: Vec<(f64, LegPose, [f64; 2])> = Vec::with_capacity(n_v + 1);
+        for i in 0..=n_v {
+            let t = t_ds * i as f64 / n_v as f64;
+            let (hp, hz) = swing_hip3(t);
+            let p = trailing.advance(trailing_clock + t, hp, hz - zf_w);
+            trail_rho.push((t, p.rho));
+            trail_poses.push((t, p, hp));
+        }
+        let trail_leg = trailing.clone();
+        // Toe-off state: the sagittal thigh and knee angles of the hip–ankle chain (so the swing
+        // starts with its ankle exactly where the stance foot left it), rates by second-order
+        // backward differences.
+        let m = trail_poses.len();
+        let sag = |i: usize| sagittal_angles(trail_poses[i].2, trail_poses[i].1.ankle, body.l3, body.l4);
+        let (q0, q1, q2) = (sag(m - 1), sag(m - 2), sag(m - 3));
+        let p0 = trail_poses[m - 1].1;
+        let hstep = t_ds / n_v as f64;
+        let d = |f0: f64, f1: f64, f2: f64| (3.0 * f0 - 4.0 * f1 + f2) / (2.0 * hstep);
+        let swing_start = SwingStart {
+            q: q0,
+            qd: [d(q0[0], q1[0], q2[0]), d(q0[1], q1[1], q2[1])],
+        };
+        // 3. The stance leg's virtual leg over the step.
+        let mut stance_leg = if from_rest && k == 0 {
+            mk_leg(ax, FootPeriod::Flat, 0.0)
+        } else {
+            mk_leg(ax, FootPeriod::HeelRocker, -prev_hs_pitch)
+        };
+        let next_times = steps.get(k + 1).map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
+        stance_leg.toe_off_time = t_step + next_times.map(|t| t.double_support).unwrap_or(times.double_support);
+        let zf_s = side_z(stance_side, a);
+        let n_s = ((t_step / dt_v).ceil() as usize).max(2);
+        let mut stance_rho = Vec::with_capacity(n_s + 1);
+        for i in 0..=n_s {
+            let t = t_step * i as f64 / n_s as f64;
+            let (hp, hz) = stance_hip(t);
+            let p = stance_leg.advance(t, hp, hz - zf_s);
+            stance_rho.push((t, p.rho));
+        }
+        // 4. Swing.
+        let t0 = t_ds;
+        let tsw = times.swing;
+        let swing_times = [t0, t0 + a.swing1_end * tsw, t0 + a.swing2_end * tsw, t_step];
+        let breakpoints = st_run.track.breakpoints();
+        let hip_fn = &swing_hip;
+        let sspec = SwingSpec {
+            model: swing_model,
+            foot,
+            hip: hip_fn,
+            breakpoints: &breakpoints,
+            times: swing_times,
+            theta3_hs: hs.theta3,
+            theta5: [p0.theta5, a.ankle_mid_swing_deg.to_radians(), theta5_hs],
+            theta6_toe_off: p0.toe_bend,
+            ankle_lift: a.ankle_lift_m,
+            tau: [
+                a.swing1_tau * (swing_times[1] - t0),
+                a.swing2_tau * (swing_times[2] - swing_times[1]),
+                a.swing3_tau * (t_step - swing_times[2]),
+            ],
+            hip_spring: [m33 * om3 * om3, 2.0 * a.swing_hip_damping * m33 * om3],
+            clearance: a.toe_clearance_m,
+            max_step: a.max_step_s,
+        };
+        let sw = sspec
+            .solve(&swing_start, swing_guess, l.speed_m_per_s)
+            .map_err(|e| num_err(stage("swing shooting"), e))?;
+        swing_guess = sw.params;
+        if std::env::var("KLAW_DUMP").is_ok() {
+            eprintln!("p0 {:?}", p0);
+            eprintln!("step {k}: start {:?} curve {:?} th3_hs {:.2}\n{}", swing_start, sw.curve, hs.theta3.to_degrees(), sw.dump(&sspec, 15));
+        }
+        // 5. Heel strike.
+        let last = *sw.track.nodes.last().ok_or_else(|| num_err(stage("swing"), "empty swing".into()))?;
+        let sh = swing_hip(t_step);
+        let new_ankle_x = ax + l.step_length_m;
+        let next_start = collision::heel_strike(
+            &body,
+            &model,
+            &st_run.end,
+            [ax, body.l9],
+            &SwingAtImpact { hip: sh.pos, hip_vel: sh.vel, theta3: [last.q[0], last.qd[0]] },
+            [new_ankle_x, body.l9],
+        );
+        report.steps.push(StepReport {
+            index: k,
+            stance_side,
+            start_s: t_global,
+            step_length_m: l.step_length_m,
+            step_freq_steps_per_min: l.step_freq_steps_per_min,
+            times,
+            iterations: [st_solved.iterations, sw.iterations[0], sw.iterations[1], sw.iterations[2]],
+            forces: [st_solved.x[0], st_solved.x[1], sw.params[0], sw.params[1], sw.params[2]],
+            errors: [st_solved.residual[1], st_solved.residual[0], sw.end_errors[0], sw.end_errors[1], sw.end_errors[2]],
+            recovery_rounds: sw.recovery_rounds,
+            min_clearance_m: sw.min_clearance,
+            lock_s: st_run.lock_time,
+        });
+        data.push(StepData {
+            side: stance_side,
+            start: t_global,
+            loc: *l,
+            times,
+            hs,
+            ankle_x: ax,
+            det,
+            stance: st_run,
+            swing: sw,
+            swing_theta5: [p0.theta5, a.ankle_mid_swing_deg.to_radians(), theta5_hs],
+            swing_theta6: p0.toe_bend,
+            swing_times,
+            stance_rho,
+            stance_leg: stance_leg.clone(),
+            trail_rho,
+            trail_leg,
+        });
+        // Next step.
+        ankle_x[idx(swing_side)] = new_ankle_x;
+        trailing = stance_leg;
+        trailing_clock = t_step;
+        prev_hs_pitch = hs.foot_pitch;
+        stance_start = next_start;
+        stance_side = swing_side;
+        t_global += t_step;
+        from_rest = false;
+    }
+    let motion = assemble(&skeleton, &body, &foot, &data, opt, t_global)?;
+    Ok((motion, report))
+}
+
+/// Builds the frames.
+fn assemble(
+    skeleton: &Skeleton,
+    body: &Body,
+    foot: &FootShape,
+    data: &[StepData],
+    opt: &WalkOptions,
+    total: f64,
+) -> Result<Motion, GenerateError> {
+    let a = &opt.attributes;
+    let mut meta = MotionMetadata::new("klaw", Some(Gait::Walk));
+    meta.push("height_m", opt.height_m);
+    meta.push("mass_kg", opt.mass_kg);
+    if let Some(d) = data.first() {
+        meta.push("speed_m_per_s", d.loc.speed_m_per_s);
+        meta.push("step_length_m", d.loc.step_length_m);
+        meta.push("step_freq_steps_per_min", d.loc.step_freq_steps_per_min);
+    }
+    let mut motion = Motion::new(skeleton.clone(), opt.fps, meta)?;
+    let frames = (total * opt.fps).floor() as usize + 1;
+    motion.reserve(frames);
+    let arm_gain = a.arm_swing_deg / 25.0;
+    let swing_model = super::dynamics::SwingModel::new(body);
+    for i in 0..frames {
+        let t = (i as f64 / opt.fps).min(total);
+        let k = data.partition_point(|d| d.start <= t).saturating_sub(1);
+        let d = &data[k];
+        let tau = (t - d.start).clamp(0.0, d.times.step);
+        let (q, _, _) = d.stance.track.at(tau);
+        let x_dyn = d.ankle_x + q[0] * q[1].sin();
+        let y_dyn = body.l9 + q[0] * q[1].cos();
+        let off = d.det.swing_offset(tau);
+        let z_c = d.det.lateral_at(tau);
+        let mut pose = skeleton.rest_pose();
+        pose.root = DVec3::new(x_dyn, y_dyn + off.y, z_c);
+        let pelvis = d.det.pelvis(tau);
+        pose.rotations[Joint::Pelvis.index()] = pelvis;
+        let stance = d.side;
+        let swing = stance.opposite();
+        // Stance leg (virtual leg).
+        let rho = interp_rho(&d.stance_rho, tau);
+        let (ankle, pitch, bend) = foot.rolled(d.stance_leg.flat_ankle, rho, d.stance_leg.theta6_max);
+        let stance_thigh = place_leg(skeleton, &mut pose, stance, [ankle[0], ankle[1], side_z(stance, a)], pitch, bend);
+        // Swing / trailing leg.
+        let (swing_thigh, contact_w) = if tau < d.swing_times[0] {
+            let rho = interp_rho(&d.trail_rho, tau);
+            let (ankle, pitch, bend) = foot.rolled(d.trail_leg.flat_ankle, rho, d.trail_leg.theta6_max);
+            (place_leg(skeleton, &mut pose, swing, [ankle[0], ankle[1], side_z(swing, a)], pitch, bend), true)
+        } else {
+            let (sq, _, _) = d.swing.track.at(tau);
+            let hip = [x_dyn + off.x, y_dyn + 2.0 * off.y];
+            let (_, an) = swing_model.knee_ankle(&sq);
+            let [t0, t1, _, t3] = d.swing_times;
+            let [to, mid, hs5] = d.swing_theta5;
+            let s1 = smoothstep((tau - t0) / (t1 - t0));
+            let th5 = if tau <= t1 { to + (mid - to) * s1 } else { mid + (hs5 - mid) * smoothstep((tau - t1) / (t3 - t1)) };
+            let th6 = d.swing_theta6 * (1.0 - s1);
+            let pitch = th5 - FRAC_PI_2 - (sq[0] + sq[1]);
+            (place_leg(skeleton, &mut pose, swing, [hip[0] + an[0], hip[1] + an[1], side_z(swing, a)], pitch, th6), false)
+        };
+        // Spine: the upper body's lean θ2, counter-rotating the pelvic rotation.
+        let yaw = Euler::from_quat(pelvis).y;
+        let lean = q[2];
+        pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_y(yaw) * DQuat::from_rotation_z(-lean));
+        pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, -yaw * a.spine_compensation));
+        pose.set_world_rotation(Joint::Head, DQuat::from_rotation_y(yaw * (1.0 - a.spine_compensation)));
+        // Arms swing with the opposite leg (flexion = −thigh angle).
+        for (side, opposite_thigh) in [(stance, swing_thigh), (swing, stance_thigh)] {
+            let [_, shoulder, elbow, _] = Joint::arm(side);
+            let flex = -arm_gain * opposite_thigh;
+            pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
+            let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
+            pose.set_euler(elbow, Euler::sagittal(elbow_flex));
+        }
+        let mut contact = [false; 2];
+        contact[match stance {
+            Side::Left => 0,
+            Side::Right => 1,
+        }] = true;
+        contact[match swing {
+            Side::Left => 0,
+            Side::Right => 1,
+        }] = contact_w;
+        motion.push_frame(pose, contact);
+    }
+    // Events.
+    let mut events = Vec::new();
+    let ev = |t: f64, side: Side, kind: EventKind| GaitEvent { time_s: t, side, kind, source: EventSource::Generated };
+    for (k, d) in data.iter().enumerate() {
+        if k > 0 || !opt.start_from_rest {
+            events.push(ev(d.start, d.side, EventKind::HeelStrike));
+        }
+        events.push(ev(d.start + d.times.double_support, d.side.opposite(), EventKind::ToeOff));
+        let tr = d.stance_leg.transitions;
+        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff].iter().enumerate() {
+            if let Some(tt) = tr[j] {
+                events.push(ev(d.start + tt, d.side, *kind));
+            }
+        }
+        let tr = d.trail_leg.transitions;
+        let prev_start = if k > 0 { data[k - 1].start } else { d.start };
+        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff].iter().enumerate() {
+            if let Some(tt) = tr[j] {
+                let g = prev_start + tt;
+                if g >= d.start - 1e-12 && g <= d.start + d.times.double_support + 1e-12 {
+                    events.push(ev(g, d.side.opposite(), *kind));
+                }
+            }
+        }
+    }
+    if let Some(d) = data.last() {
+        events.push(ev(d.start + d.times.step, d.side.opposite(), EventKind::HeelStrike));
+    }
+    events.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
+    events.dedup_by(|x, y| x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9);
+    motion.events = events;
+    Ok(motion)
+}
+
+/// Thigh angle θ3 and knee flexion θ4 of the sagittal two-link chain from `hip` to `ankle`.
+pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64; 2] {
+    let dx = hip[0] - ankle[0];
+    let dy = hip[1] - ankle[1];
+    let d = dx.hypot(dy).clamp((l3 - l4).abs() + 1e-12, l3 + l4);
+    let cos_k = ((l3 * l3 + l4 * l4 - d * d) / (2.0 * l3 * l4)).clamp(-1.0, 1.0);
+    let knee = PI - cos_k.acos();
+    // Angle at the hip between the hip–ankle line and the thigh; the knee bends forward.
+    let cos_h = ((l3 * l3 + d * d - l4 * l4) / (2.0 * l3 * d)).clamp(-1.0, 1.0);
+    let line = dx.atan2(dy); // the hip–ankle line's angle, same sign convention as θ3
+    [line - cos_h.acos(), knee]
+}
+
+/// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
+/// Returns the sagittal thigh angle (positive: knee behind the hip).
+fn place_leg(skeleton: &Skeleton, pose: &mut crate::generator::skeleton::Pose, side: Side, ankle: [f64; 3], pitch: f64, bend: f64) -> f64 {
+    let target = DVec3::new(ankle[0], ankle[1], ankle[2]);
+    leg_ik(skeleton, pose, side, target, DVec3::X);
+    let [hip, _, ank, mtp] = Joint::leg(side);
+    pose.set_world_rotation(ank, DQuat::from_rotation_z(pitch));
+    pose.set_euler(mtp, Euler::sagittal(bend));
+    let g = skeleton.forward(pose);
+    let h = g.position(hip);
+    let kn = g.position(Joint::leg(side)[1]);
+    (h.x - kn.x).atan2(h.y - kn.y)
+}

@@ -1,0 +1,234 @@
+//! The virtual leg (§4.2, figure 6): a full leg (hip, knee, ankle, metatarsal joint, toe)
+//! superimposed on the telescopic stance leg. The hip comes from the dynamics, the foot's
+//! pivot is fixed on the ground, and rules about the foot's motion pick one configuration out of
+//! the infinitely many:
+//! - *normal period*: after heel strike the foot rotates about the heel, with the knee straight,
+//!   until it is flat (the leg's reach decides: while the flat foot's ankle is out of reach of the
+//!   extended leg the foot stays pitched up); then the foot stays flat and the knee takes up the
+//!   telescopic leg's shortening, until the ankle's dorsiflexion θ5 reaches its limit;
+//! - *heel-off period*: the foot rolls about the metatarsal joint (toes flat) just enough to keep
+//!   θ5 at its limit and the ankle within reach, until the toe bend θ6 reaches its limit;
+//! - *meta-off period*: the whole foot rolls about the toe tip while the knee flexes (C¹ blend)
+//!   to its toe-off value — through the double support, when the leg's stance is completed
+//!   kinematically (§3), until toe-off; θ5 at toe-off follows (the paper: "known from the
+//!   kinematic meta-off period").
+//!
+//! All the rules are one-dimensional roots in the foot's roll coordinate `ρ`
+//! ([`FootShape::rolled`]); `ρ` never decreases after the foot is flat. Distances are measured in
+//! three dimensions (the hip's lateral offset from the foot, `dz`, is included), so the leg drawn
+//! in 3D reaches its ankle exactly.
+use super::foot::{smoothstep, FootShape};
+use std::f64::consts::FRAC_PI_2;
+
+/// How far the foot may roll about the toe tip beyond the toe-bend limit, rad (80°).
+const RHO_CAP: f64 = 1.4;
+
+/// The periods of the stance foot (§4.2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FootPeriod {
+    /// Rotating about the heel after heel strike.
+    HeelRocker,
+    /// Flat on the ground.
+    Flat,
+    /// Heel off: rolling about the metatarsal joint.
+    HeelOff,
+    /// Meta off: rolling about the toe tip.
+    MetaOff,
+}
+
+/// One evaluated configuration of the virtual leg (sagittal plane of its foot).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegPose {
+    /// Roll coordinate.
+    pub rho: f64,
+    /// Ankle position (x, y), m.
+    pub ankle: [f64; 2],
+    /// Foot pitch (toes up positive), rad.
+    pub pitch: f64,
+    /// Toe bend θ6, rad.
+    pub toe_bend: f64,
+    /// Knee flexion, rad (≥ 0).
+    pub knee: f64,
+    /// Thigh angle θ3 from the vertical (positive: knee behind the hip), rad.
+    pub thigh: f64,
+    /// Ankle angle θ5, rad.
+    pub theta5: f64,
+    /// Whether the leg reaches its ankle.
+    pub reached: bool,
+    /// The period.
+    pub period: FootPeriod,
+}
+
+/// The stance leg's foot rules and their state.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VirtualLeg {
+    /// The foot.
+    pub foot: FootShape,
+    /// Thigh and shank lengths, m.
+    pub l3: f64,
+    /// Shank length, m.
+    pub l4: f64,
+    /// Flat-foot ankle position (x, y), m.
+    pub flat_ankle: [f64; 2],
+    /// Dorsiflexion limit of θ5 that starts heel-off, rad.
+    pub theta5_max: f64,
+    /// Toe-bend limit θ6 that starts meta-off, rad.
+    pub theta6_max: f64,
+    /// Knee flexion at toe-off, reached through the meta-off period, rad.
+    pub knee_toe_off: f64,
+    /// Time of toe-off in the leg's own clock, s (set when known).
+    pub toe_off_time: f64,
+    /// Current period.
+    pub period: FootPeriod,
+    /// Current roll.
+    pub rho: f64,
+    /// Start of meta-off: time and knee flexion then.
+    pub meta_start: Option<(f64, f64)>,
+    /// Times the periods began (foot flat, heel off, meta off), s.
+    pub transitions: [Option<f64>; 3],
+}
+
+impl VirtualLeg {
+    /// Evaluates the leg for the hip at `hip` (x, y) with lateral offset `dz` for roll `rho`.
+    pub fn pose_at(&self, hip: [f64; 2], dz: f64, rho: f64) -> LegPose {
+        let (ankle, pitch, toe_bend) = self.foot.rolled(self.flat_ankle, rho, self.theta6_max);
+        let dx = hip[0] - ankle[0];
+        let dy_in_plane = ((hip[1] - ankle[1]).powi(2) + dz * dz).sqrt();
+        let d = dx.hypot(dy_in_plane);
+        let (l3, l4) = (self.l3, self.l4);
+        let reached = d <= l3 + l4 && d >= (l3 - l4).abs();
+        let dc = d.clamp((l3 - l4).abs() + 1e-12, l3 + l4);
+        // In the leg plane: hip at (dx, dy) from the ankle; the knee bends forward.
+        let cos_k = ((l3 * l3 + l4 * l4 - dc * dc) / (2.0 * l3 * l4)).clamp(-1.0, 1.0);
+        let knee = std::f64::consts::PI - cos_k.acos();
+        // Angle at the ankle between the ankle–hip line and the shank.
+        let cos_a = ((l4 * l4 + dc * dc - l3 * l3) / (2.0 * l4 * dc)).clamp(-1.0, 1.0);
+        let line = dx.atan2(dy_in_plane); // forward tilt of the ankle–hip line
+        let shank_tilt = line + cos_a.acos(); // knee forward of that line
+        let knee_pos = [l4 * shank_tilt.sin(), l4 * shank_tilt.cos()];
+        let thigh = (dx - knee_pos[0]).atan2(dy_in_plane - knee_pos[1]);
+        LegPose {
+            rho,
+            ankle,
+            pitch,
+            toe_bend,
+            knee,
+            thigh,
+            theta5: FRAC_PI_2 + pitch + shank_tilt,
+            reached,
+            period: self.period,
+        }
+    }
+
+    /// Finds the smallest `ρ ≥ lo` with `g(ρ) ≤ 0` for a decreasing `g`, by bisection.
+    fn smallest(&self, lo: f64, hi: f64, g: impl Fn(f64) -> f64) -> f64 {
+        if g(lo) <= 0.0 {
+            return lo;
+        }
+        let (mut a, mut b) = (lo, hi);
+        if g(b) > 0.0 {
+            return b;
+        }
+        for _ in 0..60 {
+            let m = 0.5 * (a + b);
+            if g(m) > 0.0 {
+                a = m;
+            } else {
+                b = m;
+            }
+            if b - a < 1e-12 {
+                break;
+            }
+        }
+        b
+    }
+
+    /// Advances the rules to time `t` (leg clock) with the hip at `hip` and lateral offset `dz`
+    /// and returns the configuration. Calls must come in time order.
+    pub fn advance(&mut self, t: f64, hip: [f64; 2], dz: f64) -> LegPose {
+        let l1 = self.l3 + self.l4;
+        let reach = |p: &LegPose, hip: [f64; 2]| {
+            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+            (hip[0] - p.ankle[0]).hypot(dy) - l1
+        };
+        if self.period == FootPeriod::HeelRocker {
+            // Largest ρ ≤ 0 within reach of the straight leg: reach(ρ) increases with ρ here.
+            let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip);
+            if g(0.0) <= 0.0 {
+                self.period = FootPeriod::Flat;
+                self.rho = 0.0;
+                self.transitions[0] = Some(t);
+            } else {
+                let (mut a, mut b) = (-1.2, 0.0);
+                if g(a) > 0.0 {
+                    self.rho = a;
+                } else {
+                    for _ in 0..60 {
+                        let m = 0.5 * (a + b);
+                        if g(m) > 0.0 {
+                            b = m;
+                        } else {
+                            a = m;
+                        }
+                        if b - a < 1e-12 {
+                            break;
+                        }
+                    }
+                    self.rho = a.max(self.rho);
+                }
+                let mut p = self.pose_at(hip, dz, self.rho);
+                p.period = self.period;
+                return p;
+            }
+        }
+        let cap = self.theta6_max + RHO_CAP;
+        if self.period != FootPeriod::MetaOff {
+            // Normal (flat) and heel-off: the least roll that keeps the ankle within its
+            // dorsiflexion limit and within reach.
+            let g = |r: f64| {
+                let p = self.pose_at(hip, dz, r);
+                (p.theta5 - self.theta5_max).max(reach(&p, hip))
+            };
+            let lo = self.rho.max(0.0);
+            if g(self.theta6_max.max(lo)) <= 0.0 || lo >= self.theta6_max {
+                let rho = if lo >= self.theta6_max { lo } else { self.smallest(lo, self.theta6_max, g) };
+                if rho > 0.0 && self.period == FootPeriod::Flat {
+                    self.period = FootPeriod::HeelOff;
+                    self.transitions[1] = Some(t);
+                }
+                if lo < self.theta6_max || rho <= self.theta6_max {
+                    self.rho = rho;
+                    let mut p = self.pose_at(hip, dz, rho);
+                    p.period = self.period;
+                    return p;
+                }
+            }
+            // The toe bend reached its limit: meta-off.
+            if self.period == FootPeriod::Flat {
+                self.transitions[1] = Some(t);
+            }
+            self.period = FootPeriod::MetaOff;
+            self.transitions[2] = Some(t);
+            self.rho = self.rho.max(self.theta6_max);
+            let p = self.pose_at(hip, dz, self.rho);
+            self.meta_start = Some((t, p.knee));
+        }
+        // Meta-off: the knee flexes (C¹ blend) toward its toe-off value; the foot rolls about the
+        // toe tip just enough to close the chain.
+        let (t_ms, knee_ms) = self.meta_start.unwrap_or((t, 0.0));
+        let s = smoothstep((t - t_ms) / (self.toe_off_time - t_ms).max(1e-6));
+        let knee = knee_ms + (self.knee_toe_off - knee_ms) * s;
+        let (l3, l4) = (self.l3, self.l4);
+        let d_target = (l3 * l3 + l4 * l4 + 2.0 * l3 * l4 * knee.cos()).sqrt();
+        let g = |r: f64| {
+            let p = self.pose_at(hip, dz, r);
+            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+            (hip[0] - p.ankle[0]).hypot(dy) - d_target
+        };
+        let rho = self.smallest(self.rho, cap.max(self.rho), g);
+        self.rho = rho;
+        let mut p = self.pose_at(hip, dz, rho);
+        p.period = self.period;
+        p
+    }
+}
