@@ -5,9 +5,11 @@
 //! - *normal period*: after heel strike the foot rotates about the heel, with the knee straight,
 //!   until it is flat (the leg's reach decides: while the flat foot's ankle is out of reach of the
 //!   extended leg the foot stays pitched up); then the foot stays flat and the knee takes up the
-//!   telescopic leg's shortening, until the ankle's dorsiflexion θ5 reaches its limit;
+//!   telescopic leg's shortening, until the ankle's dorsiflexion θ5 reaches its limit or the
+//!   foot has to roll for the leg to reach;
 //! - *heel-off period*: the foot rolls about the metatarsal joint (toes flat) just enough to keep
-//!   θ5 at its limit and the ankle within reach, until the toe bend θ6 reaches its limit;
+//!   the ankle within reach of the (straightened) leg — the telescopic leg's extension beyond
+//!   `l1` is the plantar flexion it simulates — until the toe bend θ6 reaches its limit;
 //! - *meta-off period*: the whole foot rolls about the toe tip while the knee flexes (C¹ blend)
 //!   to its toe-off value — through the double support, when the leg's stance is completed
 //!   kinematically (§3), until toe-off; θ5 at toe-off follows (the paper: "known from the
@@ -19,6 +21,9 @@
 //! in 3D reaches its ankle exactly.
 use super::foot::{smoothstep, FootShape};
 use std::f64::consts::FRAC_PI_2;
+
+/// Width of the knee's soft straightening in late stance, m.
+const KNEE_SOFT: f64 = 0.0015;
 
 /// How far the foot may roll about the toe tip beyond the toe-bend limit, rad (80°).
 const RHO_CAP: f64 = 1.4;
@@ -120,16 +125,27 @@ impl VirtualLeg {
         }
     }
 
-    /// Finds the smallest `ρ ≥ lo` with `g(ρ) ≤ 0` for a decreasing `g`, by bisection.
+    /// Finds the first `ρ ≥ lo` (continuing from `lo`, the previous roll) with `g(ρ) ≤ 0`: a
+    /// scan in small increments, then bisection inside the increment — `g` need not be monotone,
+    /// and the roll never jumps to a distant root.
     fn smallest(&self, lo: f64, hi: f64, g: impl Fn(f64) -> f64) -> f64 {
         if g(lo) <= 0.0 {
             return lo;
         }
-        let (mut a, mut b) = (lo, hi);
-        if g(b) > 0.0 {
-            return b;
+        let step = 0.004;
+        let mut a = lo;
+        let mut b = lo;
+        loop {
+            if b >= hi {
+                return hi;
+            }
+            a = b;
+            b = (b + step).min(hi);
+            if g(b) <= 0.0 {
+                break;
+            }
         }
-        for _ in 0..60 {
+        for _ in 0..50 {
             let m = 0.5 * (a + b);
             if g(m) > 0.0 {
                 a = m;
@@ -183,25 +199,38 @@ impl VirtualLeg {
         }
         let cap = self.theta6_max + RHO_CAP;
         if self.period != FootPeriod::MetaOff {
-            // Normal (flat) and heel-off: the least roll that keeps the ankle within its
-            // dorsiflexion limit and within reach.
-            let g = |r: f64| {
-                let p = self.pose_at(hip, dz, r);
-                (p.theta5 - self.theta5_max).max(reach(&p, hip))
+            // Normal (flat) and heel-off: the least roll that keeps the ankle within reach of the
+            // leg (so the knee straightens before the heel rises, as in late stance). The normal
+            // period ends — heel-off begins — when θ5 reaches its dorsiflexion limit or the foot
+            // must roll, whichever comes first.
+            // The knee straightens smoothly: the leg's length follows the hip–flat-ankle distance
+            // up to l1 − 2σ, then a C¹ quadratic blend saturating at l1 − σ (a knee flexion of
+            // about 5° at σ = 1.5 mm), so the knee comes to rest without a kink.
+            let d_flat = {
+                let p = self.pose_at(hip, dz, 0.0);
+                reach(&p, hip) + l1
             };
+            let sigma = KNEE_SOFT;
+            let a0 = l1 - 2.0 * sigma;
+            let d_t = if d_flat <= a0 {
+                d_flat
+            } else if d_flat >= l1 {
+                l1 - sigma
+            } else {
+                d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
+            };
+            let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip) + l1 - d_t;
             let lo = self.rho.max(0.0);
-            if g(self.theta6_max.max(lo)) <= 0.0 || lo >= self.theta6_max {
-                let rho = if lo >= self.theta6_max { lo } else { self.smallest(lo, self.theta6_max, g) };
-                if rho > 0.0 && self.period == FootPeriod::Flat {
-                    self.period = FootPeriod::HeelOff;
-                    self.transitions[1] = Some(t);
-                }
-                if lo < self.theta6_max || rho <= self.theta6_max {
-                    self.rho = rho;
-                    let mut p = self.pose_at(hip, dz, rho);
-                    p.period = self.period;
-                    return p;
-                }
+            let rho = self.smallest(lo, cap, g);
+            if self.period == FootPeriod::Flat && (rho > 0.0 || self.pose_at(hip, dz, rho).theta5 >= self.theta5_max) {
+                self.period = FootPeriod::HeelOff;
+                self.transitions[1] = Some(t);
+            }
+            if rho <= self.theta6_max {
+                self.rho = rho;
+                let mut p = self.pose_at(hip, dz, rho);
+                p.period = self.period;
+                return p;
             }
             // The toe bend reached its limit: meta-off.
             if self.period == FootPeriod::Flat {
@@ -209,7 +238,7 @@ impl VirtualLeg {
             }
             self.period = FootPeriod::MetaOff;
             self.transitions[2] = Some(t);
-            self.rho = self.rho.max(self.theta6_max);
+            self.rho = self.theta6_max.max(self.rho);
             let p = self.pose_at(hip, dz, self.rho);
             self.meta_start = Some((t, p.knee));
         }
