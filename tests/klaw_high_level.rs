@@ -16,7 +16,7 @@ fn fig10(sl: Option<f64>) -> (f64, f64) {
     let l = complete(
         &p,
         1.8,
-        &WalkRelations::PUBLISHED,
+        &WalkRelations::published(),
         &WalkAttributes::default(),
     )
     .unwrap();
@@ -46,7 +46,7 @@ fn anatomical_limits_give_clear_errors() {
         step_length_m: Some(0.45),
         ..Default::default()
     };
-    let e = complete(&p, 1.8, &WalkRelations::PUBLISHED, &a)
+    let e = complete(&p, 1.8, &WalkRelations::published(), &a)
         .unwrap_err()
         .to_string();
     assert!(e.contains("sf_max") && e.contains("182"), "{e}");
@@ -55,7 +55,7 @@ fn anatomical_limits_give_clear_errors() {
         step_freq_steps_per_min: Some(60.0),
         ..Default::default()
     };
-    let e = complete(&p, 1.8, &WalkRelations::PUBLISHED, &a)
+    let e = complete(&p, 1.8, &WalkRelations::published(), &a)
         .unwrap_err()
         .to_string();
     assert!(e.contains("step_length_m"), "{e}");
@@ -63,20 +63,20 @@ fn anatomical_limits_give_clear_errors() {
         speed_m_per_s: Some(-1.0),
         ..Default::default()
     };
-    assert!(complete(&p, 1.8, &WalkRelations::PUBLISHED, &a).is_err());
-    assert!(complete(&WalkParams::default(), 1.8, &WalkRelations::PUBLISHED, &a).is_err());
+    assert!(complete(&p, 1.8, &WalkRelations::published(), &a).is_err());
+    assert!(complete(&WalkParams::default(), 1.8, &WalkRelations::published(), &a).is_err());
     // Inconsistent triple.
     let p = WalkParams {
         speed_m_per_s: Some(1.0),
         step_length_m: Some(0.7),
         step_freq_steps_per_min: Some(100.0),
     };
-    assert!(complete(&p, 1.8, &WalkRelations::PUBLISHED, &a).is_err());
+    assert!(complete(&p, 1.8, &WalkRelations::published(), &a).is_err());
 }
 
 #[test]
 fn completion_is_consistent_for_every_combination() {
-    let rel = WalkRelations::PUBLISHED;
+    let rel = WalkRelations::published();
     let a = WalkAttributes::default();
     for p in [
         WalkParams {
@@ -120,7 +120,7 @@ fn completion_is_consistent_for_every_combination() {
 #[test]
 fn double_support_relation_and_eq_2() {
     // sf = 107.5: t_ds = (29.08 − 0.16·107.5)% of the cycle = 11.88 % of 1.1163 s.
-    let t = phase_times(107.5, &WalkRelations::PUBLISHED);
+    let t = phase_times(107.5, &WalkRelations::published());
     assert!((t.double_support - 0.1188 * 120.0 / 107.5).abs() < 1e-12);
     assert!((t.stance - (t.step + t.double_support)).abs() < 1e-15);
     assert!((t.swing - (t.step - t.double_support)).abs() < 1e-15);

@@ -52,8 +52,14 @@ pub fn heel_strike(
     let (s3, c3) = th3.sin_cos();
     let mut h_leg = (body.i3 + body.i4) * th3d;
     for (m, r) in [(body.m3, body.r3), (body.m4, body.l3 + body.r4)] {
-        let p = [swing.hip[0] - r * s3 - new_ankle[0], swing.hip[1] - r * c3 - new_ankle[1]];
-        let v = [swing.hip_vel[0] - r * th3d * c3, swing.hip_vel[1] + r * th3d * s3];
+        let p = [
+            swing.hip[0] - r * s3 - new_ankle[0],
+            swing.hip[1] - r * c3 - new_ankle[1],
+        ];
+        let v = [
+            swing.hip_vel[0] - r * th3d * c3,
+            swing.hip_vel[1] + r * th3d * s3,
+        ];
         h_leg += m * (p[1] * v[0] - p[0] * v[1]);
     }
     let p = [
@@ -78,18 +84,34 @@ mod tests {
         let old_ankle = [0.0, b.l9];
         let hip = [0.89 * 0.44f64.sin(), b.l9 + 0.89 * 0.44f64.cos()];
         // A massless-looking case: the swing leg moving with the hip and not rotating.
-        let vh = [0.1 * 0.44f64.sin() + 0.89 * 1.8 * 0.44f64.cos(), 0.1 * 0.44f64.cos() - 0.89 * 1.8 * 0.44f64.sin()];
-        let sw = SwingAtImpact { hip, hip_vel: vh, theta3: [-0.4, 0.0] };
+        let vh = [
+            0.1 * 0.44f64.sin() + 0.89 * 1.8 * 0.44f64.cos(),
+            0.1 * 0.44f64.cos() - 0.89 * 1.8 * 0.44f64.sin(),
+        ];
+        let sw = SwingAtImpact {
+            hip,
+            hip_vel: vh,
+            theta3: [-0.4, 0.0],
+        };
         let new_ankle = [0.77, b.l9];
         let s = heel_strike(&b, &model, &old, old_ankle, &sw, new_ankle);
         // Hip position is continuous.
-        let h2 = [new_ankle[0] + s.q[0] * s.q[1].sin(), new_ankle[1] + s.q[0] * s.q[1].cos()];
+        let h2 = [
+            new_ankle[0] + s.q[0] * s.q[1].sin(),
+            new_ankle[1] + s.q[0] * s.q[1].cos(),
+        ];
         assert!((h2[0] - hip[0]).abs() < 1e-12 && (h2[1] - hip[1]).abs() < 1e-12);
         // The upper body's linear momentum changes only by what the leg brings in: compare the
         // hip velocity before and after (equal within a few percent for a leg moving with it).
         let (s1, c1) = s.q[1].sin_cos();
-        let vh2 = [s.qd[0] * s1 + s.q[0] * s.qd[1] * c1, s.qd[0] * c1 - s.q[0] * s.qd[1] * s1];
-        assert!((vh2[0] - vh[0]).abs() < 0.15 * vh[0].abs(), "{vh:?} → {vh2:?}");
+        let vh2 = [
+            s.qd[0] * s1 + s.q[0] * s.qd[1] * c1,
+            s.qd[0] * c1 - s.q[0] * s.qd[1] * s1,
+        ];
+        assert!(
+            (vh2[0] - vh[0]).abs() < 0.15 * vh[0].abs(),
+            "{vh:?} → {vh2:?}"
+        );
         // Angular momentum about the new pivot is conserved: compute it both ways.
         let m_new = model.mass_matrix(&s.q);
         let p_theta1: f64 = (0..3).map(|j| m_new[1][j] * s.qd[j]).sum();

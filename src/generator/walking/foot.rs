@@ -41,7 +41,12 @@ pub struct FootShape {
 impl FootShape {
     /// The foot of `body`.
     pub fn new(body: &Body) -> FootShape {
-        FootShape { heel: body.heel, mtp: body.mtp, ball: body.ball, toe: body.toe }
+        FootShape {
+            heel: body.heel,
+            mtp: body.mtp,
+            ball: body.ball,
+            toe: body.toe,
+        }
     }
 
     /// Heel, ball and toe positions for an ankle at `ankle`, pitch `phi` and toe bend `theta6`.
@@ -50,7 +55,12 @@ impl FootShape {
         let mtp = add(ankle, rot(phi, self.mtp));
         let ball = add(mtp, rot(phi + theta6, sub(self.ball, self.mtp)));
         let toe = add(mtp, rot(phi + theta6, sub(self.toe, self.mtp)));
-        FootPoints { heel, mtp, ball, toe }
+        FootPoints {
+            heel,
+            mtp,
+            ball,
+            toe,
+        }
     }
 
     /// The stance foot rolling on the ground (§4.2), parametrized by one roll coordinate `ρ`

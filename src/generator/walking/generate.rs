@@ -10,7 +10,7 @@ use super::body::Body;
 use super::collision::{self, SwingAtImpact};
 use super::dynamics::{HipMotion, StanceModel};
 use super::foot::{smoothstep, FootShape};
-use super::high_level::{heel_strike, phase_times, HeelStrike, Locomotion, PhaseTimes, WalkRelations};
+use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::swing::{SwingRun, SwingSpec, SwingStart};
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
@@ -47,7 +47,7 @@ impl Default for WalkOptions {
             height_m: 1.8,
             mass_kg: 75.0,
             attributes: WalkAttributes::default(),
-            relations: WalkRelations::PUBLISHED,
+            relations: WalkRelations::published(),
             fps: 100.0,
             start_from_rest: false,
             stop: false,
@@ -146,7 +146,10 @@ impl Determinants {
     /// ψ(t).
     pub fn rotation_at(&self, t: f64) -> f64 {
         let c = (PI * (t / self.duration).clamp(0.0, 1.0)).cos();
-        let (a, b) = (if self.from_rest { 0.0 } else { -self.rotation }, if self.to_rest { 0.0 } else { self.rotation });
+        let (a, b) = (
+            if self.from_rest { 0.0 } else { -self.rotation },
+            if self.to_rest { 0.0 } else { self.rotation },
+        );
         a + (b - a) * 0.5 * (1.0 - c)
     }
     /// λ(t).
@@ -155,7 +158,9 @@ impl Determinants {
     }
     /// Lateral position of the pelvis centre (toward the stance foot), m.
     pub fn lateral_at(&self, t: f64) -> f64 {
-        -Determinants::side_sign(self.swing) * self.lateral * (PI * (t / self.duration).clamp(0.0, 1.0)).sin()
+        -Determinants::side_sign(self.swing)
+            * self.lateral
+            * (PI * (t / self.duration).clamp(0.0, 1.0)).sin()
     }
     /// Pelvis orientation (figure convention) at `t`.
     pub fn pelvis(&self, t: f64) -> DQuat {
@@ -164,7 +169,12 @@ impl Determinants {
     }
     /// Offset of the swing hip from the pelvis centre, m.
     pub fn swing_offset(&self, t: f64) -> DVec3 {
-        self.pelvis(t) * DVec3::new(0.0, 0.0, Determinants::side_sign(self.swing) * self.half_width)
+        self.pelvis(t)
+            * DVec3::new(
+                0.0,
+                0.0,
+                Determinants::side_sign(self.swing) * self.half_width,
+            )
     }
     /// Swing hip minus the dynamic hip in the sagittal plane `(dx, dy)` (the stance hip is at
     /// `(−dx_offset, 0)`; see [`Determinants::swing_offset`]).
@@ -179,7 +189,6 @@ struct StepData {
     start: f64,
     loc: Locomotion,
     times: PhaseTimes,
-    hs: HeelStrike,
     ankle_x: f64,
     det: Determinants,
     stance: StanceRun,
@@ -225,7 +234,10 @@ fn side_z(side: Side, a: &WalkAttributes) -> f64 {
 }
 
 /// Generates a walk of the given steps (complete locomotion parameters, one per step).
-pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion, WalkReport), GenerateError> {
+pub fn generate_steps(
+    steps: &[Locomotion],
+    opt: &WalkOptions,
+) -> Result<(Motion, WalkReport), GenerateError> {
     let a = &opt.attributes;
     a.validate()?;
     let skeleton = Skeleton::from_height(opt.height_m, opt.mass_kg)?;
@@ -258,7 +270,10 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
         Side::Right => 1,
     };
     let mut stance_side = Side::Left;
-    let mut stance_start = StanceStart { q: [body.l1, 0.0, a.trunk_lean_deg.to_radians()], qd: [0.0; 3] };
+    let mut stance_start = StanceStart {
+        q: [body.l1, 0.0, a.trunk_lean_deg.to_radians()],
+        qd: [0.0; 3],
+    };
     let mut from_rest = opt.start_from_rest;
     if !from_rest {
         // A steady start: the state a previous identical step would leave (approximated from
@@ -298,7 +313,11 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
     let mut stance_guess = [0.0, 0.0];
     let mut swing_guess = [0.0, 0.0, 0.0, 0.0];
     let mut t_global = 0.0;
-    let mut prev_hs_pitch = if from_rest { 0.0 } else { heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch };
+    let mut prev_hs_pitch = if from_rest {
+        0.0
+    } else {
+        heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch
+    };
     let n = steps.len();
     for (k, l) in steps.iter().enumerate() {
         let stage = |what: &str| format!("step {k} ({} stance), {what}", stance_side);
@@ -316,7 +335,12 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
             from_rest,
             to_rest,
         };
-        let hs = heel_strike(&body, l.step_length_m, theta5_hs, if to_rest { 0.0 } else { ahead })?;
+        let hs = heel_strike(
+            &body,
+            l.step_length_m,
+            theta5_hs,
+            if to_rest { 0.0 } else { ahead },
+        )?;
         // 1. Stance.
         let spec = StanceSpec {
             model,
@@ -332,8 +356,9 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
             target: [hs.w, hs.theta1],
             max_step: a.max_step_s,
         };
-        let (st_solved, st_run) =
-            spec.solve(&stance_start, stance_guess).map_err(|e| num_err(stage("stance shooting"), e))?;
+        let (st_solved, st_run) = spec
+            .solve(&stance_start, stance_guess)
+            .map_err(|e| num_err(stage("stance shooting"), e))?;
         stance_guess = st_solved.x;
         let ax = ankle_x[idx(stance_side)];
         let track = st_run.track.clone();
@@ -370,7 +395,11 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
         };
         // 2. The trailing leg completes its stance through the double support.
         let dt_v = 1e-3;
-        let t_ds = if from_rest { times.double_support } else { times.double_support };
+        let t_ds = if from_rest {
+            times.double_support
+        } else {
+            times.double_support
+        };
         trailing.toe_off_time = trailing_clock + t_ds;
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
@@ -388,7 +417,8 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
         // starts with its ankle exactly where the stance foot left it), rates by second-order
         // backward differences.
         let m = trail_poses.len();
-        let sag = |i: usize| sagittal_angles(trail_poses[i].2, trail_poses[i].1.ankle, body.l3, body.l4);
+        let sag =
+            |i: usize| sagittal_angles(trail_poses[i].2, trail_poses[i].1.ankle, body.l3, body.l4);
         let (q0, q1, q2) = (sag(m - 1), sag(m - 2), sag(m - 3));
         let p0 = trail_poses[m - 1].1;
         let hstep = t_ds / n_v as f64;
@@ -403,8 +433,13 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
         } else {
             mk_leg(ax, FootPeriod::HeelRocker, -prev_hs_pitch)
         };
-        let next_times = steps.get(k + 1).map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
-        stance_leg.toe_off_time = t_step + next_times.map(|t| t.double_support).unwrap_or(times.double_support);
+        let next_times = steps
+            .get(k + 1)
+            .map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
+        stance_leg.toe_off_time = t_step
+            + next_times
+                .map(|t| t.double_support)
+                .unwrap_or(times.double_support);
         let zf_s = side_z(stance_side, a);
         let n_s = ((t_step / dt_v).ceil() as usize).max(2);
         let mut stance_rho = Vec::with_capacity(n_s + 1);
@@ -445,10 +480,20 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
         swing_guess = sw.params;
         if std::env::var("KLAW_DUMP").is_ok() {
             eprintln!("p0 {:?}", p0);
-            eprintln!("step {k}: start {:?} curve {:?} th3_hs {:.2}\n{}", swing_start, sw.curve, hs.theta3.to_degrees(), sw.dump(&sspec, 15));
+            eprintln!(
+                "step {k}: start {:?} curve {:?} th3_hs {:.2}\n{}",
+                swing_start,
+                sw.curve,
+                hs.theta3.to_degrees(),
+                sw.dump(&sspec, 15)
+            );
         }
         // 5. Heel strike.
-        let last = *sw.track.nodes.last().ok_or_else(|| num_err(stage("swing"), "empty swing".into()))?;
+        let last = *sw
+            .track
+            .nodes
+            .last()
+            .ok_or_else(|| num_err(stage("swing"), "empty swing".into()))?;
         let sh = swing_hip(t_step);
         let new_ankle_x = ax + l.step_length_m;
         let next_start = collision::heel_strike(
@@ -456,7 +501,11 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
             &model,
             &st_run.end,
             [ax, body.l9],
-            &SwingAtImpact { hip: sh.pos, hip_vel: sh.vel, theta3: [last.q[0], last.qd[0]] },
+            &SwingAtImpact {
+                hip: sh.pos,
+                hip_vel: sh.vel,
+                theta3: [last.q[0], last.qd[0]],
+            },
             [new_ankle_x, body.l9],
         );
         report.steps.push(StepReport {
@@ -466,9 +515,26 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
             step_length_m: l.step_length_m,
             step_freq_steps_per_min: l.step_freq_steps_per_min,
             times,
-            iterations: [st_solved.iterations, sw.iterations[0], sw.iterations[1], sw.iterations[2]],
-            forces: [st_solved.x[0], st_solved.x[1], sw.params[0], sw.params[1], sw.params[2]],
-            errors: [st_solved.residual[1], st_solved.residual[0], sw.end_errors[0], sw.end_errors[1], sw.end_errors[2]],
+            iterations: [
+                st_solved.iterations,
+                sw.iterations[0],
+                sw.iterations[1],
+                sw.iterations[2],
+            ],
+            forces: [
+                st_solved.x[0],
+                st_solved.x[1],
+                sw.params[0],
+                sw.params[1],
+                sw.params[2],
+            ],
+            errors: [
+                st_solved.residual[1],
+                st_solved.residual[0],
+                sw.end_errors[0],
+                sw.end_errors[1],
+                sw.end_errors[2],
+            ],
             recovery_rounds: sw.recovery_rounds,
             min_clearance_m: sw.min_clearance,
             lock_s: st_run.lock_time,
@@ -478,7 +544,6 @@ pub fn generate_steps(steps: &[Locomotion], opt: &WalkOptions) -> Result<(Motion
             start: t_global,
             loc: *l,
             times,
-            hs,
             ankle_x: ax,
             det,
             stance: st_run,
@@ -546,13 +611,32 @@ fn assemble(
         let swing = stance.opposite();
         // Stance leg (virtual leg).
         let rho = interp_rho(&d.stance_rho, tau);
-        let (ankle, pitch, bend) = foot.rolled(d.stance_leg.flat_ankle, rho, d.stance_leg.theta6_max);
-        let stance_thigh = place_leg(skeleton, &mut pose, stance, [ankle[0], ankle[1], side_z(stance, a)], pitch, bend);
+        let (ankle, pitch, bend) =
+            foot.rolled(d.stance_leg.flat_ankle, rho, d.stance_leg.theta6_max);
+        let stance_thigh = place_leg(
+            skeleton,
+            &mut pose,
+            stance,
+            [ankle[0], ankle[1], side_z(stance, a)],
+            pitch,
+            bend,
+        );
         // Swing / trailing leg.
         let (swing_thigh, contact_w) = if tau < d.swing_times[0] {
             let rho = interp_rho(&d.trail_rho, tau);
-            let (ankle, pitch, bend) = foot.rolled(d.trail_leg.flat_ankle, rho, d.trail_leg.theta6_max);
-            (place_leg(skeleton, &mut pose, swing, [ankle[0], ankle[1], side_z(swing, a)], pitch, bend), true)
+            let (ankle, pitch, bend) =
+                foot.rolled(d.trail_leg.flat_ankle, rho, d.trail_leg.theta6_max);
+            (
+                place_leg(
+                    skeleton,
+                    &mut pose,
+                    swing,
+                    [ankle[0], ankle[1], side_z(swing, a)],
+                    pitch,
+                    bend,
+                ),
+                true,
+            )
         } else {
             let (sq, _, _) = d.swing.track.at(tau);
             let hip = [x_dyn + off.x, y_dyn + 2.0 * off.y];
@@ -560,17 +644,40 @@ fn assemble(
             let [t0, t1, _, t3] = d.swing_times;
             let [to, mid, hs5] = d.swing_theta5;
             let s1 = smoothstep((tau - t0) / (t1 - t0));
-            let th5 = if tau <= t1 { to + (mid - to) * s1 } else { mid + (hs5 - mid) * smoothstep((tau - t1) / (t3 - t1)) };
+            let th5 = if tau <= t1 {
+                to + (mid - to) * s1
+            } else {
+                mid + (hs5 - mid) * smoothstep((tau - t1) / (t3 - t1))
+            };
             let th6 = d.swing_theta6 * (1.0 - s1);
             let pitch = th5 - FRAC_PI_2 - (sq[0] + sq[1]);
-            (place_leg(skeleton, &mut pose, swing, [hip[0] + an[0], hip[1] + an[1], side_z(swing, a)], pitch, th6), false)
+            (
+                place_leg(
+                    skeleton,
+                    &mut pose,
+                    swing,
+                    [hip[0] + an[0], hip[1] + an[1], side_z(swing, a)],
+                    pitch,
+                    th6,
+                ),
+                false,
+            )
         };
         // Spine: the upper body's lean θ2, counter-rotating the pelvic rotation.
         let yaw = Euler::from_quat(pelvis).y;
         let lean = q[2];
-        pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_y(yaw) * DQuat::from_rotation_z(-lean));
-        pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, -yaw * a.spine_compensation));
-        pose.set_world_rotation(Joint::Head, DQuat::from_rotation_y(yaw * (1.0 - a.spine_compensation)));
+        pose.set_world_rotation(
+            Joint::Lumbar,
+            DQuat::from_rotation_y(yaw) * DQuat::from_rotation_z(-lean),
+        );
+        pose.set_euler(
+            Joint::ThoracicUpper,
+            Euler::new(0.0, 0.0, -yaw * a.spine_compensation),
+        );
+        pose.set_world_rotation(
+            Joint::Head,
+            DQuat::from_rotation_y(yaw * (1.0 - a.spine_compensation)),
+        );
         // Arms swing with the opposite leg (flexion = −thigh angle).
         for (side, opposite_thigh) in [(stance, swing_thigh), (swing, stance_thigh)] {
             let [_, shoulder, elbow, _] = Joint::arm(side);
@@ -592,21 +699,36 @@ fn assemble(
     }
     // Events.
     let mut events = Vec::new();
-    let ev = |t: f64, side: Side, kind: EventKind| GaitEvent { time_s: t, side, kind, source: EventSource::Generated };
+    let ev = |t: f64, side: Side, kind: EventKind| GaitEvent {
+        time_s: t,
+        side,
+        kind,
+        source: EventSource::Generated,
+    };
     for (k, d) in data.iter().enumerate() {
         if k > 0 || !opt.start_from_rest {
             events.push(ev(d.start, d.side, EventKind::HeelStrike));
         }
-        events.push(ev(d.start + d.times.double_support, d.side.opposite(), EventKind::ToeOff));
+        events.push(ev(
+            d.start + d.times.double_support,
+            d.side.opposite(),
+            EventKind::ToeOff,
+        ));
         let tr = d.stance_leg.transitions;
-        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff].iter().enumerate() {
+        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff]
+            .iter()
+            .enumerate()
+        {
             if let Some(tt) = tr[j] {
                 events.push(ev(d.start + tt, d.side, *kind));
             }
         }
         let tr = d.trail_leg.transitions;
         let prev_start = if k > 0 { data[k - 1].start } else { d.start };
-        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff].iter().enumerate() {
+        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff]
+            .iter()
+            .enumerate()
+        {
             if let Some(tt) = tr[j] {
                 let g = prev_start + tt;
                 if g >= d.start - 1e-12 && g <= d.start + d.times.double_support + 1e-12 {
@@ -616,10 +738,16 @@ fn assemble(
         }
     }
     if let Some(d) = data.last() {
-        events.push(ev(d.start + d.times.step, d.side.opposite(), EventKind::HeelStrike));
+        events.push(ev(
+            d.start + d.times.step,
+            d.side.opposite(),
+            EventKind::HeelStrike,
+        ));
     }
     events.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
-    events.dedup_by(|x, y| x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9);
+    events.dedup_by(|x, y| {
+        x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9
+    });
     motion.events = events;
     Ok(motion)
 }
@@ -639,7 +767,14 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
 
 /// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
 /// Returns the sagittal thigh angle (positive: knee behind the hip).
-fn place_leg(skeleton: &Skeleton, pose: &mut crate::generator::skeleton::Pose, side: Side, ankle: [f64; 3], pitch: f64, bend: f64) -> f64 {
+fn place_leg(
+    skeleton: &Skeleton,
+    pose: &mut crate::generator::skeleton::Pose,
+    side: Side,
+    ankle: [f64; 3],
+    pitch: f64,
+    bend: f64,
+) -> f64 {
     let target = DVec3::new(ankle[0], ankle[1], ankle[2]);
     leg_ik(skeleton, pose, side, target, DVec3::X);
     let [hip, _, ank, mtp] = Joint::leg(side);

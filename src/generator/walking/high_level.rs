@@ -7,32 +7,66 @@
 use super::attributes::WalkAttributes;
 use super::body::Body;
 use crate::generator::GenerateError;
+use crate::relations::walk_sl_sf::WalkSlSf;
+use crate::relations::walk_tds_sf::WalkTdsSf;
 use crate::units::{hz_to_steps_per_min, m_per_min_to_m_per_s, m_per_s_to_m_per_min};
+use std::path::Path;
 
-/// The two walking relations KLAW uses: eq. (1) `sl / (sf·h) = k` and
-/// `t_ds = (d0 + d1·sf)·t_cycle/100` (sf in steps/min, percentages of the cycle).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The two walking relations KLAW uses, from the relations layer: eq. (1) `sl / (sf·h) = k`
+/// ([`WalkSlSf`]) and `t_ds = (d0 + d1·sf)·t_cycle/100` ([`WalkTdsSf`]), published or refitted.
+#[derive(Debug, Clone, PartialEq)]
 pub struct WalkRelations {
-    /// Normalizing constant `k` of eq. (1), m per (steps/min · m).
-    pub k: f64,
-    /// Intercept `d0` of the double-support relation, % of the cycle.
-    pub d0: f64,
-    /// Slope `d1` of the double-support relation, % of the cycle per step/min.
-    pub d1: f64,
+    /// Eq. (1).
+    pub sl_sf: WalkSlSf,
+    /// The double-support relation.
+    pub tds_sf: WalkTdsSf,
 }
 
 impl WalkRelations {
-    /// The published values: k = 0.004 (eq. 1), d0 = 29.08, d1 = −0.16 (§3).
-    pub const PUBLISHED: WalkRelations = WalkRelations {
-        k: 0.004,
-        d0: 29.08,
-        d1: -0.16,
-    };
+    /// The published relations: k = 0.004, d0 = 29.08, d1 = −0.16 (§3).
+    pub fn published() -> WalkRelations {
+        WalkRelations {
+            sl_sf: WalkSlSf::published(),
+            tds_sf: WalkTdsSf::published(),
+        }
+    }
+
+    /// The refitted relations `DIR/walk-sl-sf.json` and `DIR/walk-tds-sf.json` (`--fits DIR`).
+    pub fn from_fits_dir(dir: &Path) -> Result<WalkRelations, GenerateError> {
+        let load_err = |id: &str, e: String| {
+            GenerateError::Parameter {
+            name: "fits".into(),
+            value: f64::NAN,
+            message: format!(
+                "{}: {e}; run `gaitfit fit` to write it, or omit --fits to use the published relations",
+                dir.join(format!("{id}.json")).display()
+            ),
+        }
+        };
+        let sl_sf = WalkSlSf::from_fit_file(&dir.join(format!("{}.json", WalkSlSf::ID)))
+            .map_err(|e| load_err(WalkSlSf::ID, e.to_string()))?;
+        let tds_sf = WalkTdsSf::from_fit_file(&dir.join(format!("{}.json", WalkTdsSf::ID)))
+            .map_err(|e| load_err(WalkTdsSf::ID, e.to_string()))?;
+        Ok(WalkRelations { sl_sf, tds_sf })
+    }
+
+    /// `k` of eq. (1).
+    pub fn k(&self) -> f64 {
+        self.sl_sf.k()
+    }
+    /// `d0`, % of the cycle.
+    pub fn d0(&self) -> f64 {
+        self.tds_sf.d0()
+    }
+    /// `d1`, % of the cycle per step/min.
+    pub fn d1(&self) -> f64 {
+        self.tds_sf.d1()
+    }
 }
 
 impl Default for WalkRelations {
     fn default() -> Self {
-        WalkRelations::PUBLISHED
+        WalkRelations::published()
     }
 }
 
@@ -85,7 +119,7 @@ fn positive(name: &str, v: Option<f64>) -> Result<Option<f64>, GenerateError> {
 /// use gaitfit::generator::walking::attributes::WalkAttributes;
 /// // Fig. 10, top: only v = 5 km/h given, h = 1.8 m → sl ≈ 0.77 m, sf ≈ 107.5 steps/min.
 /// let p = WalkParams { speed_m_per_s: Some(5.0 / 3.6), ..Default::default() };
-/// let l = complete(&p, 1.8, &WalkRelations::PUBLISHED, &WalkAttributes::default()).unwrap();
+/// let l = complete(&p, 1.8, &WalkRelations::published(), &WalkAttributes::default()).unwrap();
 /// assert!((l.step_length_m - 0.77).abs() < 0.005);
 /// assert!((l.step_freq_steps_per_min - 107.5).abs() < 0.1);
 /// ```
@@ -98,11 +132,11 @@ pub fn complete(
     let v = positive("speed_m_per_s", p.speed_m_per_s)?.map(m_per_s_to_m_per_min);
     let sl = positive("step_length_m", p.step_length_m)?;
     let sf = positive("step_freq_steps_per_min", p.step_freq_steps_per_min)?;
-    let kh = rel.k * height_m;
+    let kh = rel.k() * height_m;
     let (v, sl, sf) = match (v, sl, sf) {
         (Some(v), None, None) => {
             // sf² = v / (k·h), eq. (1).
-            let sf = (v / kh).sqrt();
+            let sf = rel.sl_sf.step_freq_for_speed(v, height_m);
             (v, v / sf, sf)
         }
         (Some(v), Some(sl), None) => (v, sl, v / sl),
@@ -113,7 +147,7 @@ pub fn complete(
             (sl * sf, sl, sf)
         }
         (None, None, Some(sf)) => {
-            let sl = rel.k * sf * height_m;
+            let sl = rel.sl_sf.step_length(sf, height_m);
             (sl * sf, sl, sf)
         }
         (Some(v), Some(sl), Some(sf)) => {
@@ -192,7 +226,7 @@ pub fn check_limits(
             ),
         ));
     }
-    let ds_pct = rel.d0 + rel.d1 * sf;
+    let ds_pct = rel.tds_sf.double_support_pct(sf);
     if ds_pct <= 0.0 || ds_pct >= 50.0 {
         return Err(param_err(
             "step_freq_steps_per_min",
@@ -225,7 +259,7 @@ pub struct PhaseTimes {
 ///
 /// ```
 /// use gaitfit::generator::walking::high_level::{phase_times, WalkRelations};
-/// let t = phase_times(107.5, &WalkRelations::PUBLISHED);
+/// let t = phase_times(107.5, &WalkRelations::published());
 /// assert!((t.step - 60.0 / 107.5).abs() < 1e-12);
 /// assert!((t.double_support - (29.08 - 0.16 * 107.5) * t.cycle / 100.0).abs() < 1e-12);
 /// assert!((t.stance - t.double_support - t.step).abs() < 1e-12);
@@ -234,7 +268,7 @@ pub struct PhaseTimes {
 pub fn phase_times(sf_steps_per_min: f64, rel: &WalkRelations) -> PhaseTimes {
     let step = 60.0 / sf_steps_per_min;
     let cycle = 2.0 * step;
-    let double_support = (rel.d0 + rel.d1 * sf_steps_per_min) * cycle / 100.0;
+    let double_support = rel.tds_sf.double_support_time(sf_steps_per_min);
     PhaseTimes {
         step,
         cycle,

@@ -40,7 +40,13 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
         f(x)
     };
     let (mut a, mut fa) = (x0, eval(x0, &mut evals));
-    let done = |x: f64, r: f64, n: usize| Ok(Solved { x: [x], residual: [r], iterations: n });
+    let done = |x: f64, r: f64, n: usize| {
+        Ok(Solved {
+            x: [x],
+            residual: [r],
+            iterations: n,
+        })
+    };
     if fa.abs() <= tol {
         return done(a, fa, evals);
     }
@@ -69,7 +75,11 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
             std::mem::swap(&mut fa, &mut fb);
         }
         let d = b - a;
-        let secant = if fb != fa { -fb * d / (fb - fa) } else { 2.0 * d };
+        let secant = if fb != fa {
+            -fb * d / (fb - fa)
+        } else {
+            2.0 * d
+        };
         // Continue beyond b, between half and eight times the last step.
         let step = d.signum() * secant.abs().clamp(0.5 * d.abs(), 8.0 * d.abs());
         a = b;
@@ -110,7 +120,9 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
             side = -1;
         }
     }
-    Err(format!("no convergence in {max_evals} simulations (bracket [{a}, {b}])"))
+    Err(format!(
+        "no convergence in {max_evals} simulations (bracket [{a}, {b}])"
+    ))
 }
 
 /// Solves `f(x) = 0` for two unknowns from `x0` (trial steps `dx` for the finite-difference
@@ -129,7 +141,11 @@ pub fn solve_2d<F: FnMut([f64; 2]) -> [f64; 2]>(
     let mut r = f(x);
     evals += 1;
     if ok(&r) {
-        return Ok(Solved { x, residual: r, iterations: evals });
+        return Ok(Solved {
+            x,
+            residual: r,
+            iterations: evals,
+        });
     }
     for attempt in 0..2 {
         // Finite-difference Jacobian.
@@ -188,7 +204,11 @@ pub fn solve_2d<F: FnMut([f64; 2]) -> [f64; 2]>(
             x = xn;
             r = rn;
             if ok(&r) {
-                return Ok(Solved { x, residual: r, iterations: evals });
+                return Ok(Solved {
+                    x,
+                    residual: r,
+                    iterations: evals,
+                });
             }
         }
         if !stalled || attempt == 1 {
@@ -215,7 +235,11 @@ pub fn solve_2d<F: FnMut([f64; 2]) -> [f64; 2]>(
         r = f(x);
         evals += 1;
         if ok(&r) {
-            return Ok(Solved { x, residual: r, iterations: evals });
+            return Ok(Solved {
+                x,
+                residual: r,
+                iterations: evals,
+            });
         }
     }
     Err(format!(
@@ -244,7 +268,12 @@ mod tests {
 
     #[test]
     fn two_dimensional_secant_solves_a_coupled_system() {
-        let f = |x: [f64; 2]| [x[0] + 0.3 * x[1].sin() - 1.0, x[1] + 0.2 * x[0] * x[0] - 2.0];
+        let f = |x: [f64; 2]| {
+            [
+                x[0] + 0.3 * x[1].sin() - 1.0,
+                x[1] + 0.2 * x[0] * x[0] - 2.0,
+            ]
+        };
         let s = solve_2d(f, [0.0, 0.0], [1e-3, 1e-3], [1e-12, 1e-12], 50).unwrap();
         let r = f(s.x);
         assert!(r[0].abs() <= 1e-12 && r[1].abs() <= 1e-12);

@@ -27,7 +27,7 @@
 //! here the shooting makes it reach that length exactly at the end, so that lock never engages
 //! and is not implemented.
 use super::dynamics::{solve2, StanceModel};
-use super::integrate::{integrate, stable_step, spectral_radius};
+use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_2d, Solved};
 use super::track::{Node, Track};
 
@@ -106,7 +106,15 @@ impl StanceSpec {
         [fw, f1, f2]
     }
 
-    fn deriv(&self, t: f64, y: &[f64; 7], a: f64, sub: Sub, ext: (f64, f64, f64), floor: f64) -> [f64; 7] {
+    fn deriv(
+        &self,
+        t: f64,
+        y: &[f64; 7],
+        a: f64,
+        sub: Sub,
+        ext: (f64, f64, f64),
+        floor: f64,
+    ) -> [f64; 7] {
         let q = [y[0], y[1], y[2]];
         let qd = [y[3], y[4], y[5]];
         let f = self.forces(t, y, a, sub, ext);
@@ -123,7 +131,14 @@ impl StanceSpec {
     /// The integration step: the attribute's maximum, reduced if the stiffness requires it
     /// (see [`super::integrate`]).
     pub fn step(&self, start: &StanceStart) -> f64 {
-        let y = [start.q[0], start.q[1], start.q[2], start.qd[0], start.qd[1], start.qd[2]];
+        let y = [
+            start.q[0],
+            start.q[1],
+            start.q[2],
+            start.qd[0],
+            start.qd[1],
+            start.qd[2],
+        ];
         let mut f = |t: f64, y6: &[f64; 6]| {
             let y7 = [y6[0], y6[1], y6[2], y6[3], y6[4], y6[5], 0.0];
             let d = self.deriv(t, &y7, 0.0, Sub::Extend, (0.0, 0.0, 0.0), 0.0);
@@ -138,7 +153,15 @@ impl StanceSpec {
         let m2g = self.model.m2 * self.model.g;
         // pa starts at the static preload of the upper body's weight (rest length l1 under load).
         let pa0 = m2g * start.q[1].cos() / self.k_w;
-        let mut y = [start.q[0], start.q[1], start.q[2], start.qd[0], start.qd[1], start.qd[2], pa0];
+        let mut y = [
+            start.q[0],
+            start.q[1],
+            start.q[2],
+            start.qd[0],
+            start.qd[1],
+            start.qd[2],
+            pa0,
+        ];
         let mut t = 0.0;
         let mut sub = if y[1] >= 0.0 {
             Sub::Extend
@@ -153,10 +176,19 @@ impl StanceSpec {
         let mut track = Track::default();
         let node = |spec: &StanceSpec, t: f64, y: &[f64; 7], sub: Sub, ext| {
             let d = spec.deriv(t, y, a, sub, ext, floor);
-            Node { t, q: [y[0], y[1], y[2]], qd: [y[3], y[4], y[5]], qdd: [d[3], d[4], d[5]] }
+            Node {
+                t,
+                q: [y[0], y[1], y[2]],
+                qd: [y[3], y[4], y[5]],
+                qdd: [d[3], d[4], d[5]],
+            }
         };
         while t < self.duration {
-            let t_end = if t < self.torque_off { self.torque_off.min(self.duration) } else { self.duration };
+            let t_end = if t < self.torque_off {
+                self.torque_off.min(self.duration)
+            } else {
+                self.duration
+            };
             if record {
                 track.push(node(self, t, &y, sub, ext));
             }
@@ -214,12 +246,21 @@ impl StanceSpec {
         if record {
             track.push(node(self, t, &y, sub, ext));
         }
-        StanceRun { end: [y[0], y[1], y[2], y[3], y[4], y[5]], lock_time, extend_time, track }
+        StanceRun {
+            end: [y[0], y[1], y[2], y[3], y[4], y[5]],
+            lock_time,
+            extend_time,
+            track,
+        }
     }
 
     /// Finds `A` and `P` so that `w(t_step)` and `θ1(t_step)` meet the targets, starting from the
     /// previous step's values `guess`, and returns them with the recorded run.
-    pub fn solve(&self, start: &StanceStart, guess: [f64; 2]) -> Result<(Solved<2>, StanceRun), String> {
+    pub fn solve(
+        &self,
+        start: &StanceStart,
+        guess: [f64; 2],
+    ) -> Result<(Solved<2>, StanceRun), String> {
         let h = self.step(start);
         let f = |x: [f64; 2]| {
             let r = self.run(start, x[0], x[1], h, false);

@@ -103,7 +103,12 @@ impl AnkleCurve {
         );
         let rhs = nalgebra::Vector4::new(a_max - a0, 0.0, a_min - a0, 0.0);
         let sol = m.lu().solve(&rhs)?;
-        Some(AnkleCurve { c: [a0, sol[0], sol[1], sol[2], sol[3]], x0, d, heights: [a0, a_max, a_min] })
+        Some(AnkleCurve {
+            c: [a0, sol[0], sol[1], sol[2], sol[3]],
+            x0,
+            d,
+            heights: [a0, a_max, a_min],
+        })
     }
 
     /// `(y, dy/dx)` at ankle position `x` (absolute).
@@ -148,7 +153,11 @@ impl SwingSpec<'_> {
         let [t0, t1, _, t3] = self.times;
         let [to, mid, hs] = self.theta5;
         let s1 = smoothstep((t - t0) / (t1 - t0));
-        let th5 = if t <= t1 { to + (mid - to) * s1 } else { mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1)) };
+        let th5 = if t <= t1 {
+            to + (mid - to) * s1
+        } else {
+            mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1))
+        };
         (th5, self.theta6_toe_off * (1.0 - s1))
     }
 
@@ -168,7 +177,12 @@ impl SwingSpec<'_> {
     }
 
     fn segments(&self, a: f64, b: f64) -> Vec<(f64, f64)> {
-        let mut cuts: Vec<f64> = self.breakpoints.iter().copied().filter(|&x| x > a && x < b).collect();
+        let mut cuts: Vec<f64> = self
+            .breakpoints
+            .iter()
+            .copied()
+            .filter(|&x| x > a && x < b)
+            .collect();
         cuts.sort_by(f64::total_cmp);
         cuts.dedup_by(|x, y| (*x - *y).abs() < 1e-12);
         let mut out = Vec::new();
@@ -182,7 +196,12 @@ impl SwingSpec<'_> {
     }
 
     /// The ankle curve from the toe-off state.
-    pub fn curve(&self, start: &SwingStart, speed: f64, extra_lift: f64) -> Result<AnkleCurve, String> {
+    pub fn curve(
+        &self,
+        start: &SwingStart,
+        speed: f64,
+        extra_lift: f64,
+    ) -> Result<AnkleCurve, String> {
         let [t0, t1, _, _] = self.times;
         let (_, a0) = self.joints(t0, &start.q);
         // At t1 the thigh is at its heel-strike angle and the toe is under the knee.
@@ -208,7 +227,8 @@ impl SwingSpec<'_> {
         // If the toe would come closer to the ground than the clearance there, flex the knee
         // further until it clears (the ankle then sits higher and further back).
         if self.foot_points(t1, &[self.theta3_hs, th4]).toe[1] < self.clearance {
-            let toe_y = |k4: f64| self.foot_points(t1, &[self.theta3_hs, k4]).toe[1] - self.clearance;
+            let toe_y =
+                |k4: f64| self.foot_points(t1, &[self.theta3_hs, k4]).toe[1] - self.clearance;
             let (mut lo, mut hi) = (th4, th4 + 1.5);
             if toe_y(hi) > 0.0 {
                 for _ in 0..60 {
@@ -225,12 +245,15 @@ impl SwingSpec<'_> {
         let (_, a1) = self.joints(t1, &[self.theta3_hs, th4]);
         let d = a1[0] - a0[0];
         if !(d > 0.0) {
-            return Err(format!("the ankle would not move forward in swing1 (D = {d:.3} m)"));
+            return Err(format!(
+                "the ankle would not move forward in swing1 (D = {d:.3} m)"
+            ));
         }
         let a_min = a1[1] + extra_lift;
         let lift = self.ankle_lift / speed.max(0.5);
         let a_max = a0[1].max(a_min) + lift;
-        AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min).ok_or_else(|| "ankle curve is singular".to_string())
+        AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
+            .ok_or_else(|| "ankle curve is singular".to_string())
     }
 
     /// The knee angle that puts the ankle on the curve, by Newton from `guess`.
@@ -257,7 +280,15 @@ impl SwingSpec<'_> {
         th4
     }
 
-    fn swing1(&self, start: &SwingStart, curve: &AnkleCurve, a: f64, tau: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
+    fn swing1(
+        &self,
+        start: &SwingStart,
+        curve: &AnkleCurve,
+        a: f64,
+        tau: f64,
+        h: f64,
+        rec: Option<&mut Track<2>>,
+    ) -> [f64; 2] {
         let [t0, t1, _, _] = self.times;
         let mut cache = start.q[1];
         let mut y = [start.q[0], start.qd[0]];
@@ -268,7 +299,9 @@ impl SwingSpec<'_> {
                 cache = th4;
                 let hip = (self.hip)(t);
                 let ft = a * (-(t - t0) / tau).exp();
-                let acc = self.model.accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+                let acc = self
+                    .model
+                    .accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
                 [y[1], acc[0]]
             };
             if let Some(r) = rec.as_deref_mut() {
@@ -299,7 +332,9 @@ impl SwingSpec<'_> {
         let eps = 1e-5;
         let hip = (self.hip)(t);
         let ft = a * (-(t - t0) / tau).exp();
-        let acc = self.model.accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+        let acc = self
+            .model
+            .accel(&[y[0], th4], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
         let th4p = self.knee_on_curve(t + eps, y[0] + eps * y[1], curve, th4);
         let th4m = self.knee_on_curve(t - eps, y[0] - eps * y[1], curve, th4);
         Node {
@@ -310,7 +345,14 @@ impl SwingSpec<'_> {
         }
     }
 
-    fn swing2(&self, y0: [f64; 4], b: f64, pa: f64, h: f64, rec: Option<&mut Track<2>>) -> ([f64; 4], f64) {
+    fn swing2(
+        &self,
+        y0: [f64; 4],
+        b: f64,
+        pa: f64,
+        h: f64,
+        rec: Option<&mut Track<2>>,
+    ) -> ([f64; 4], f64) {
         let [_, t1, t2, _] = self.times;
         let [k3, c3] = self.hip_spring;
         let tau = self.tau[1];
@@ -320,7 +362,9 @@ impl SwingSpec<'_> {
             let set = th3_hs - pa * (std::f64::consts::PI * (t - t1) / (t2 - t1)).sin();
             let f3 = -k3 * (y[0] - set) - c3 * y[2];
             let f4 = b * (-(t - t1) / tau).exp();
-            let acc = self.model.accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, f4], &hip.acc, false);
+            let acc = self
+                .model
+                .accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, f4], &hip.acc, false);
             [y[2], y[3], acc[0], acc[1]]
         };
         let mut y = y0;
@@ -329,14 +373,24 @@ impl SwingSpec<'_> {
         for (sa, sb) in self.segments(t1, t2) {
             if let Some(r) = rec.as_deref_mut() {
                 let d = f(sa, &y);
-                r.push(Node { t: sa, q: [y[0], y[1]], qd: [y[2], y[3]], qdd: [d[2], d[3]] });
+                r.push(Node {
+                    t: sa,
+                    q: [y[0], y[1]],
+                    qd: [y[2], y[3]],
+                    qdd: [d[2], d[3]],
+                });
             }
             let mut ff = f;
             let mut obs = |_: f64, _: &[f64; 4], tt: f64, yy: &[f64; 4]| {
                 lowest = lowest.min(self.foot_points(tt, &[yy[0], yy[1]]).lowest());
                 if let Some(r) = rec.as_deref_mut() {
                     let d = f(tt, yy);
-                    r.push(Node { t: tt, q: [yy[0], yy[1]], qd: [yy[2], yy[3]], qdd: [d[2], d[3]] });
+                    r.push(Node {
+                        t: tt,
+                        q: [yy[0], yy[1]],
+                        qd: [yy[2], yy[3]],
+                        qdd: [d[2], d[3]],
+                    });
                 }
             };
             let no: Option<&mut fn(f64, &[f64; 4]) -> f64> = None;
@@ -351,7 +405,9 @@ impl SwingSpec<'_> {
         let f = |t: f64, y: &[f64; 2]| {
             let hip = (self.hip)(t);
             let ft = c * (-(t - t2) / tau).exp();
-            let acc = self.model.accel(&[y[0], 0.0], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
+            let acc = self
+                .model
+                .accel(&[y[0], 0.0], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
             [y[1], acc[0]]
         };
         let mut y = y0;
@@ -359,13 +415,23 @@ impl SwingSpec<'_> {
         for (sa, sb) in self.segments(t2, t3) {
             if let Some(r) = rec.as_deref_mut() {
                 let d = f(sa, &y);
-                r.push(Node { t: sa, q: [y[0], 0.0], qd: [y[1], 0.0], qdd: [d[1], 0.0] });
+                r.push(Node {
+                    t: sa,
+                    q: [y[0], 0.0],
+                    qd: [y[1], 0.0],
+                    qdd: [d[1], 0.0],
+                });
             }
             let mut ff = f;
             let mut obs = |_: f64, _: &[f64; 2], tt: f64, yy: &[f64; 2]| {
                 if let Some(r) = rec.as_deref_mut() {
                     let d = f(tt, yy);
-                    r.push(Node { t: tt, q: [yy[0], 0.0], qd: [yy[1], 0.0], qdd: [d[1], 0.0] });
+                    r.push(Node {
+                        t: tt,
+                        q: [yy[0], 0.0],
+                        qd: [yy[1], 0.0],
+                        qdd: [d[1], 0.0],
+                    });
                 }
             };
             let no: Option<&mut fn(f64, &[f64; 2]) -> f64> = None;
@@ -375,16 +441,26 @@ impl SwingSpec<'_> {
     }
 
     /// Simulates the swing, finding `A`, `B` and `C` (from `guess`, the previous step's values).
-    pub fn solve(&self, start: &SwingStart, guess: [f64; 4], speed: f64) -> Result<SwingRun, String> {
+    pub fn solve(
+        &self,
+        start: &SwingStart,
+        guess: [f64; 4],
+        speed: f64,
+    ) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
         // Stability bound from swing2's spring–damper (the stiffest subphase).
         let mut jf = |t: f64, y: &[f64; 4]| {
             let hip = (self.hip)(t);
             let f3 = -self.hip_spring[0] * y[0] - self.hip_spring[1] * y[2];
-            let acc = self.model.accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, 0.0], &hip.acc, false);
+            let acc = self
+                .model
+                .accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, 0.0], &hip.acc, false);
             [y[2], y[3], acc[0], acc[1]]
         };
-        let h = stable_step(spectral_radius(&mut jf, t1, &[start.q[0], start.q[1], 0.0, 0.0]), self.max_step);
+        let h = stable_step(
+            spectral_radius(&mut jf, t1, &[start.q[0], start.q[1], 0.0, 0.0]),
+            self.max_step,
+        );
         let scale = self.model.mass_matrix(&[0.0, 0.0])[0][0];
         // swing1: the torque's magnitude so that the thigh reaches its heel-strike angle at t1.
         // If the foot comes closer to the ground than the clearance, the end of the ankle curve
@@ -414,11 +490,20 @@ impl SwingSpec<'_> {
             let mut deficit: f64 = 0.0;
             for n in track.nodes.iter().filter(|n| n.t > t0) {
                 let low = self.foot_points(n.t, &n.q).lowest();
-                let need = if n.t >= t_check { self.clearance } else { -5e-4 };
+                let need = if n.t >= t_check {
+                    self.clearance
+                } else {
+                    -5e-4
+                };
                 deficit = deficit.max(need - low);
             }
             if std::env::var("KLAW_DUMP2").is_ok() {
-                let worst = track.nodes.iter().filter(|n| n.t > t0).map(|n| (n.t, self.foot_points(n.t, &n.q))).min_by(|a, b| a.1.lowest().total_cmp(&b.1.lowest()));
+                let worst = track
+                    .nodes
+                    .iter()
+                    .filter(|n| n.t > t0)
+                    .map(|n| (n.t, self.foot_points(n.t, &n.q)))
+                    .min_by(|a, b| a.1.lowest().total_cmp(&b.1.lowest()));
                 eprintln!("round {lift_rounds} extra {extra:.4} deficit {deficit:.5} worst {:?} t0 {t0} t1 {t1}", worst);
             }
             if deficit <= 0.0 || lift_rounds >= 10 {
@@ -436,8 +521,14 @@ impl SwingSpec<'_> {
         let mut it2 = 0;
         let mut b_guess = guess[1];
         let (s2, lowest) = loop {
-            let s2 = solve_1d(|b| self.swing2(y2_0, b, pa, h, None).0[1], b_guess, 0.2 * scale, TOL, 60)
-                .map_err(|e| format!("swing2: {e}"))?;
+            let s2 = solve_1d(
+                |b| self.swing2(y2_0, b, pa, h, None).0[1],
+                b_guess,
+                0.2 * scale,
+                TOL,
+                60,
+            )
+            .map_err(|e| format!("swing2: {e}"))?;
             it2 += s2.iterations;
             let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
             if lowest >= self.clearance || rounds >= 20 {
@@ -452,10 +543,17 @@ impl SwingSpec<'_> {
         let _ = before;
         // Knee lock at t2: the knee's impulse leaves the thigh's generalized momentum unchanged.
         let m = self.model.mass_matrix(&[y2[0], y2[1]]);
-        let th3d = (m[0][0] * y2[2] + m[0][1] * y2[3]) / self.model.mass_matrix(&[y2[0], 0.0])[0][0];
+        let th3d =
+            (m[0][0] * y2[2] + m[0][1] * y2[3]) / self.model.mass_matrix(&[y2[0], 0.0])[0][0];
         let y3_0 = [y2[0], th3d];
-        let s3 = solve_1d(|c| self.swing3(y3_0, c, h, None)[0] - self.theta3_hs, guess[2], 0.2 * scale, TOL, 60)
-            .map_err(|e| format!("swing3: {e}"))?;
+        let s3 = solve_1d(
+            |c| self.swing3(y3_0, c, h, None)[0] - self.theta3_hs,
+            guess[2],
+            0.2 * scale,
+            TOL,
+            60,
+        )
+        .map_err(|e| format!("swing3: {e}"))?;
         let y3 = self.swing3(y3_0, s3.x[0], h, Some(&mut track));
         // Clearance over the swing from 30 % of swing1 on (the toe is leaving before that).
         let t_check = t0 + 0.3 * (t1 - t0);

@@ -40,7 +40,11 @@ impl<const N: usize> Track<N> {
 
     /// Times where two nodes coincide (switches of the equations of motion).
     pub fn breakpoints(&self) -> Vec<f64> {
-        self.nodes.windows(2).filter(|w| w[1].t == w[0].t).map(|w| w[0].t).collect()
+        self.nodes
+            .windows(2)
+            .filter(|w| w[1].t == w[0].t)
+            .map(|w| w[0].t)
+            .collect()
     }
 
     /// `(q, q̇, q̈)` at `t` (clamped to the span). For `t` on a breakpoint the later segment is
@@ -101,7 +105,12 @@ mod tests {
         let mut tr = Track::<1>::default();
         for k in 0..=50 {
             let t = k as f64 * 0.02;
-            tr.push(Node { t, q: [f(t)], qd: [2.0 * (2.0 * t).cos()], qdd: [-4.0 * f(t)] });
+            tr.push(Node {
+                t,
+                q: [f(t)],
+                qd: [2.0 * (2.0 * t).cos()],
+                qdd: [-4.0 * f(t)],
+            });
         }
         for k in 0..97 {
             let t = 0.0103 * k as f64;
@@ -115,10 +124,30 @@ mod tests {
     #[test]
     fn breakpoints_split_the_interpolation() {
         let mut tr = Track::<1>::default();
-        tr.push(Node { t: 0.0, q: [0.0], qd: [0.0], qdd: [1.0] });
-        tr.push(Node { t: 1.0, q: [0.5], qd: [1.0], qdd: [1.0] });
-        tr.push(Node { t: 1.0, q: [0.5], qd: [1.0], qdd: [-1.0] });
-        tr.push(Node { t: 2.0, q: [1.0], qd: [0.0], qdd: [-1.0] });
+        tr.push(Node {
+            t: 0.0,
+            q: [0.0],
+            qd: [0.0],
+            qdd: [1.0],
+        });
+        tr.push(Node {
+            t: 1.0,
+            q: [0.5],
+            qd: [1.0],
+            qdd: [1.0],
+        });
+        tr.push(Node {
+            t: 1.0,
+            q: [0.5],
+            qd: [1.0],
+            qdd: [-1.0],
+        });
+        tr.push(Node {
+            t: 2.0,
+            q: [1.0],
+            qd: [0.0],
+            qdd: [-1.0],
+        });
         assert_eq!(tr.breakpoints(), vec![1.0]);
         assert!((tr.at(0.5).2[0] - 1.0).abs() < 1e-12);
         assert!((tr.at(1.5).2[0] + 1.0).abs() < 1e-12);

@@ -133,7 +133,7 @@ impl VirtualLeg {
             return lo;
         }
         let step = 0.004;
-        let mut a = lo;
+        let mut a;
         let mut b = lo;
         loop {
             if b >= hi {
@@ -222,7 +222,9 @@ impl VirtualLeg {
             let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip) + l1 - d_t;
             let lo = self.rho.max(0.0);
             let rho = self.smallest(lo, cap, g);
-            if self.period == FootPeriod::Flat && (rho > 0.0 || self.pose_at(hip, dz, rho).theta5 >= self.theta5_max) {
+            if self.period == FootPeriod::Flat
+                && (rho > 0.0 || self.pose_at(hip, dz, rho).theta5 >= self.theta5_max)
+            {
                 self.period = FootPeriod::HeelOff;
                 self.transitions[1] = Some(t);
             }
