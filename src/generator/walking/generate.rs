@@ -101,8 +101,8 @@ impl WalkReport {
     pub fn total_iterations(&self) -> [usize; 4] {
         let mut t = [0; 4];
         for s in &self.steps {
-            for i in 0..4 {
-                t[i] += s.iterations[i];
+            for (ti, si) in t.iter_mut().zip(s.iterations) {
+                *ti += si;
             }
         }
         t
@@ -395,11 +395,7 @@ pub fn generate_steps(
         };
         // 2. The trailing leg completes its stance through the double support.
         let dt_v = 1e-3;
-        let t_ds = if from_rest {
-            times.double_support
-        } else {
-            times.double_support
-        };
+        let t_ds = times.double_support;
         trailing.toe_off_time = trailing_clock + t_ds;
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);

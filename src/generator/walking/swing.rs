@@ -244,7 +244,7 @@ impl SwingSpec<'_> {
         }
         let (_, a1) = self.joints(t1, &[self.theta3_hs, th4]);
         let d = a1[0] - a0[0];
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return Err(format!(
                 "the ankle would not move forward in swing1 (D = {d:.3} m)"
             ));
