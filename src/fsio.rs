@@ -58,8 +58,28 @@ where
         buf.flush().map_err(|e| FsError::io(path, e))?;
     }
     tmp.as_file().sync_all().map_err(|e| FsError::io(path, e))?;
+    // tempfile creates files readable by the owner only; give the result the permissions of
+    // the file it replaces, or ordinary rw-r--r-- for a new file.
+    let perms = match std::fs::metadata(path) {
+        Ok(m) => m.permissions(),
+        Err(_) => default_permissions(tmp.as_file()).map_err(|e| FsError::io(path, e))?,
+    };
+    tmp.as_file()
+        .set_permissions(perms)
+        .map_err(|e| FsError::io(path, e))?;
     tmp.persist(path).map_err(|e| FsError::io(path, e.error))?;
     Ok(())
+}
+
+#[cfg(unix)]
+fn default_permissions(_f: &std::fs::File) -> std::io::Result<std::fs::Permissions> {
+    use std::os::unix::fs::PermissionsExt;
+    Ok(std::fs::Permissions::from_mode(0o644))
+}
+
+#[cfg(not(unix))]
+fn default_permissions(f: &std::fs::File) -> std::io::Result<std::fs::Permissions> {
+    Ok(f.metadata()?.permissions())
 }
 
 /// Convenience wrapper of [`write_atomic`] for content already in memory.
@@ -90,6 +110,17 @@ mod tests {
             .filter(|e| e.file_name().to_string_lossy().starts_with(".gaitfit-tmp"))
             .collect();
         assert!(leftovers.is_empty());
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn new_files_are_world_readable() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("x.json");
+        write_atomic_bytes(&p, b"x").unwrap();
+        let mode = std::fs::metadata(&p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o644);
     }
 
     #[test]
