@@ -186,6 +186,43 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(cfg())]
+
+    /// Theorems 1, 3, 4 and 5 on the bundled Winter prototype, with random slopes within the
+    /// paper's bounds, random bodies and walk conditions.
+    #[test]
+    fn theorems_on_winter(a in [0.0..0.3f64, 0.0..1.5, 0.0..1.5, 0.0..1.5],
+                          k2 in factors(), k3 in factors(),
+                          l2 in 0.85..1.18f64, l3 in 0.85..1.18f64, b in 0.85..1.18f64) {
+        use gaitfit::generator::generalize::prototype::Prototype;
+        let p = Prototype::bundled();
+        let mu = p.mu(a).unwrap();
+        let w = &p.walk;
+        let sl = w.step_length();
+        // Theorem 1 / 2.
+        close(&phi(&phi(w, l2, b * sl, &mu).unwrap(), l3, b * sl, &mu).unwrap(),
+              &phi(w, l2 * l3, b * sl, &mu).unwrap())?;
+        // Theorem 3.
+        let s2 = other_body(w.body(), &k2);
+        let s3 = other_body(w.body(), &k3);
+        close(&psi(&psi(w, &s2, &mu).unwrap(), &s3, &mu).unwrap(), &psi(w, &s3, &mu).unwrap())?;
+        // Theorem 4.
+        let al = s2.ratio_to(w.body());
+        let r = l2;
+        close(&phi(&psi(w, &s2, &mu).unwrap(), r, b * sl * al, &mu).unwrap(),
+              &psi(&phi(w, r, b * sl, &mu).unwrap(), &s2, &mu).unwrap())?;
+        // Theorem 5.
+        let tau = |w: &WalkData, sj: &Anthropometry, slj: f64, bj: f64| {
+            let a = sj.ratio_to(w.body());
+            psi(&phi(w, slj / (a * w.step_length()), bj / a, &mu).unwrap(), sj, &mu).unwrap()
+        };
+        let (sl2, sl3) = (l2 * sl * al, l3 * sl * s3.ratio_to(w.body()));
+        let w2 = tau(w, &s2, sl2, b * sl2);
+        close(&tau(&w2, &s3, sl3, b * sl3), &tau(w, &s3, sl3, b * sl3))?;
+    }
+}
+
 /// Theorem 4 needs μ(S2, sl2) = μ(S1, sl2·ll(S1)/ll(S2)): ψ keeps angles, φ sets them from the
 /// μ-functions. The corrected argument satisfies it; the printed ll(S)/ll(S*)·sl does not.
 #[test]

@@ -34,6 +34,7 @@
 //! fixed (true of all the papers' relations); `predict` then comes for free. Register it in
 //! [`registry`]. The generic fit routine (`gaitfit::fit::pipeline`) produces the statistics,
 //! tables and plots without further code.
+pub mod kb_mu;
 pub mod run_sl_v;
 pub mod run_tflight_sf;
 pub mod walk_sl_sf;

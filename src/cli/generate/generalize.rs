@@ -50,6 +50,11 @@ pub struct Options {
     /// The kb-mu fit to take α from.
     #[arg(long, value_name = "FILE", default_value = "fits/kb-mu.json")]
     pub mu_fit: PathBuf,
+    /// Fit the μ-function slopes (relation `kb-mu`) on these trials tables and write the fit to
+    /// --mu-fit (the regeneration command of `fits/kb-mu.json`, until `gaitfit fit` takes
+    /// relations with several observations per row).
+    #[arg(long, value_name = "CSV", num_args = 1..)]
+    pub fit_mu: Option<Vec<PathBuf>>,
     /// Body height of the figure, m.
     #[arg(long, default_value_t = 1.75)]
     pub height: f64,
@@ -122,8 +127,28 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             crate::fsio::write_atomic_bytes(out, proto.to_json("(copied)", None).as_bytes())?;
         }
     }
+    if let Some(tables) = &args.fit_mu {
+        let f = crate::relations::kb_mu::fit_tables(tables, &proto, Some(&args.mu_fit))?;
+        for c in &f.coefficients {
+            eprintln!(
+                "{} = {:.5} {}{}{}",
+                c.name,
+                c.value,
+                c.unit,
+                c.std_error.map(|s| format!(" ± {s:.5}")).unwrap_or_default(),
+                c.flag.as_ref().map(|s| format!("  [{s}]")).unwrap_or_default()
+            );
+        }
+        eprintln!(
+            "n = {} μ values from {} subjects, rmse {:.2}°; wrote {}",
+            f.n,
+            f.n_subjects,
+            f.rmse.to_degrees(),
+            args.mu_fit.display()
+        );
+    }
     let Some(output) = &args.output else {
-        if args.write_prototype.is_some() {
+        if args.write_prototype.is_some() || args.fit_mu.is_some() {
             return Ok(ExitCode::SUCCESS);
         }
         bail!("give -o/--output FILE (.bvh, .csv or .trc), or --write-prototype");
@@ -174,6 +199,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
 }
 
 /// α from a kb-mu fit file (`coefficients` with `alpha1`…`alpha4`), if the file exists.
+// Read generically (not through `kb_mu::KbMuFit`) so a file written by `gaitfit fit` in the
+// common fits format works too.
 fn alpha_from_fit(path: &Path) -> anyhow::Result<Option<[f64; 4]>> {
     if !path.exists() {
         return Ok(None);
