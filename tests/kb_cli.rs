@@ -7,7 +7,14 @@ fn writes_a_bvh_for_a_tall_figure() {
     Command::cargo_bin("gaitfit")
         .unwrap()
         .current_dir(dir.path())
-        .args(["generate", "generalize", "--height", "1.9", "--step-length", "0.9"])
+        .args([
+            "generate",
+            "generalize",
+            "--height",
+            "1.9",
+            "--step-length",
+            "0.9",
+        ])
         .args(["--steps", "4", "-o", "walk.bvh"])
         .assert()
         .success();
@@ -23,7 +30,10 @@ fn writes_a_bvh_for_a_tall_figure() {
         .parse()
         .unwrap();
     assert!((250..300).contains(&frames), "{frames} frames");
-    assert!(bvh.index("r_knee").is_some(), "the figure's joints are in the BVH");
+    assert!(
+        bvh.index("r_knee").is_some(),
+        "the figure's joints are in the BVH"
+    );
 }
 
 #[test]
@@ -37,7 +47,14 @@ fn follows_a_schedule_and_reports_bad_rows() {
     Command::cargo_bin("gaitfit")
         .unwrap()
         .current_dir(dir.path())
-        .args(["generate", "generalize", "--height", "1.6", "--schedule", "steps.csv"])
+        .args([
+            "generate",
+            "generalize",
+            "--height",
+            "1.6",
+            "--schedule",
+            "steps.csv",
+        ])
         .args(["-o", "walk.csv"])
         .assert()
         .success();
@@ -46,11 +63,21 @@ fn follows_a_schedule_and_reports_bad_rows() {
     let out = Command::cargo_bin("gaitfit")
         .unwrap()
         .current_dir(dir.path())
-        .args(["generate", "generalize", "--schedule", "bad.csv", "-o", "w.bvh"])
+        .args([
+            "generate",
+            "generalize",
+            "--schedule",
+            "bad.csv",
+            "-o",
+            "w.bvh",
+        ])
         .assert()
         .failure();
     let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
-    assert!(err.contains("bad.csv: row 2, column step_length_m"), "{err}");
+    assert!(
+        err.contains("bad.csv: row 2, column step_length_m"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -65,7 +92,14 @@ fn a_written_prototype_reads_back() {
     Command::cargo_bin("gaitfit")
         .unwrap()
         .current_dir(dir.path())
-        .args(["generate", "generalize", "--prototype", "p.json", "--step-length", "0.7"])
+        .args([
+            "generate",
+            "generalize",
+            "--prototype",
+            "p.json",
+            "--step-length",
+            "0.7",
+        ])
         .args(["--steps", "2", "-o", "w.trc"])
         .assert()
         .success();

@@ -40,18 +40,19 @@ fn generalization_beats_naive_scaling_on_schreiber() {
     }
     assert!(strides.len() >= 20, "only {} strides built", strides.len());
 
-    let mean = |rows: &[gaitfit::generator::generalize::compare::CompareRow],
-                f: &dyn Fn(&gaitfit::generator::generalize::compare::CompareRow) -> Scores| {
-        let mut s = [0.0; 4];
-        for r in rows {
-            let v = f(r);
-            s[0] += v.hip_deg / rows.len() as f64;
-            s[1] += v.knee_deg / rows.len() as f64;
-            s[2] += v.ankle_deg / rows.len() as f64;
-            s[3] += v.ankle_path_cm / rows.len() as f64;
-        }
-        s
-    };
+    let mean =
+        |rows: &[gaitfit::generator::generalize::compare::CompareRow],
+         f: &dyn Fn(&gaitfit::generator::generalize::compare::CompareRow) -> Scores| {
+            let mut s = [0.0; 4];
+            for r in rows {
+                let v = f(r);
+                s[0] += v.hip_deg / rows.len() as f64;
+                s[1] += v.knee_deg / rows.len() as f64;
+                s[2] += v.ankle_deg / rows.len() as f64;
+                s[3] += v.ankle_path_cm / rows.len() as f64;
+            }
+            s
+        };
     for (space, rs) in [("measured", &rows), ("model", &model_rows)] {
         let g = mean(rs, &|r| r.generalized_same);
         let n = mean(rs, &|r| r.naive_same);
@@ -59,12 +60,18 @@ fn generalization_beats_naive_scaling_on_schreiber() {
         let no = mean(rs, &|r| r.naive_other);
         // The swing ankle path, which the generalization constrains (it lands at B's step
         // length, from B's toe-off pose), is clearly better than uniform scaling.
-        assert!(g[3] < 0.8 * n[3] && go[3] < 0.8 * no[3], "{space}: ankle path {g:?} vs {n:?}");
+        assert!(
+            g[3] < 0.8 * n[3] && go[3] < 0.8 * no[3],
+            "{space}: ankle path {g:?} vs {n:?}"
+        );
         println!("{space}: generalized {g:?} naive {n:?}; other speed {go:?} vs {no:?}");
     }
     // In model space (the model's own rendering error removed) the joint angles are no worse
     // than uniform scaling on average.
     let g = mean(&model_rows, &|r| r.generalized_same);
     let n = mean(&model_rows, &|r| r.naive_same);
-    assert!(g[0] + g[1] + g[2] <= n[0] + n[1] + n[2], "model space angles {g:?} vs {n:?}");
+    assert!(
+        g[0] + g[1] + g[2] <= n[0] + n[1] + n[2],
+        "model space angles {g:?} vs {n:?}"
+    );
 }

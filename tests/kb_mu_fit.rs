@@ -34,8 +34,16 @@ fn bounded_fit_equals_clamped_separable_lines() {
         // leaves the coupled intercept ≈ 3e-5 rad (0.002°) short; elsewhere 1e-6.
         let on_bound = f.coefficients[i].flag.is_some();
         let tol = if on_bound { 1e-4 } else { 1e-6 };
-        assert!((a - alpha).abs() < tol, "alpha{}: nls {a} vs closed form {alpha}", i + 1);
-        assert!((m - mu).abs() < tol, "mu{}_star: nls {m} vs closed form {mu}", i + 1);
+        assert!(
+            (a - alpha).abs() < tol,
+            "alpha{}: nls {a} vs closed form {alpha}",
+            i + 1
+        );
+        assert!(
+            (m - mu).abs() < tol,
+            "mu{}_star: nls {m} vs closed form {mu}",
+            i + 1
+        );
     }
 }
 
@@ -83,7 +91,13 @@ fn reports_an_active_bound() {
     let (a, m) = separable_line(&obs, 0, 0.7, bounds()[0]);
     assert!(a.abs() < 1e-12 && (f.get("mu1_star").unwrap() - m).abs() < 1e-6);
     // α₁ above 0.3 stops at 0.3.
-    let f = fit(&synthetic([0.6, 0.4, 0.8, 1.1], [0.05, 0.4, 1.2, 0.9], 3), 0.7, 0.8, vec![]).unwrap();
+    let f = fit(
+        &synthetic([0.6, 0.4, 0.8, 1.1], [0.05, 0.4, 1.2, 0.9], 3),
+        0.7,
+        0.8,
+        vec![],
+    )
+    .unwrap();
     assert!((f.alpha()[0] - 0.3).abs() < 1e-6);
 }
 
@@ -98,7 +112,12 @@ fn committed_fit_is_reproducible_and_is_the_default() {
     assert_eq!(set.relation, "kb-mu");
     for c in &f.coefficients {
         let v = set.get(&c.name).unwrap();
-        assert!((v - c.value).abs() < 1e-9, "{}: committed {v}, refit {}", c.name, c.value);
+        assert!(
+            (v - c.value).abs() < 1e-9,
+            "{}: committed {v}, refit {}",
+            c.name,
+            c.value
+        );
     }
     for (i, a) in DEFAULT_ALPHA.iter().enumerate() {
         let v = set.get(&format!("alpha{}", i + 1)).unwrap();

@@ -135,8 +135,13 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
                 c.name,
                 c.value,
                 c.unit,
-                c.std_error.map(|s| format!(" ± {s:.5}")).unwrap_or_default(),
-                c.flag.as_ref().map(|s| format!("  [{s}]")).unwrap_or_default()
+                c.std_error
+                    .map(|s| format!(" ± {s:.5}"))
+                    .unwrap_or_default(),
+                c.flag
+                    .as_ref()
+                    .map(|s| format!("  [{s}]"))
+                    .unwrap_or_default()
             );
         }
         eprintln!(
