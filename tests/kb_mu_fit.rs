@@ -26,8 +26,8 @@ fn bounded_fit_equals_clamped_separable_lines() {
         .collect();
     let (obs, _, _) = gaitfit::relations::kb_mu::observations(&tables, p.walk.body().leg_length());
     let b = bounds();
-    for i in 0..4 {
-        let (alpha, mu) = separable_line(&obs, i, sl, b[i]);
+    for (i, bi) in b.iter().enumerate().take(4) {
+        let (alpha, mu) = separable_line(&obs, i, sl, *bi);
         let a = f.get(&format!("alpha{}", i + 1)).unwrap();
         let m = f.get(&format!("mu{}_star", i + 1)).unwrap();
         // On an active bound MINUIT's sine transform flattens the cost, and the stopping rule

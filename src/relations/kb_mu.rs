@@ -110,9 +110,9 @@ pub fn observations(
     let mut ll_star = prototype_leg_length;
     for t in tables {
         if let Some(ll) = col(t, Quantity::LegLength) {
-            for i in 0..t.len() {
-                if t.subject_name(i) == WINTER_SUBJECT && ll[i].is_finite() {
-                    ll_star = ll[i];
+            for (i, &v) in ll.iter().enumerate() {
+                if t.subject_name(i) == WINTER_SUBJECT && v.is_finite() {
+                    ll_star = v;
                 }
             }
         }
