@@ -5,6 +5,7 @@ pub mod checks;
 pub mod generalize;
 pub mod ik;
 pub mod motion;
+pub mod running;
 pub mod skeleton;
 pub mod walking;
 
