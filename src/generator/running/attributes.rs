@@ -195,7 +195,7 @@ pub const SPECS: [AttrSpec; 19] = [
         doc: "heel ahead of the pelvis at impact; falls with speed" },
     AttrSpec { attr: Attr::StrideWidth, name: "stride_width", unit: AttrUnit::Metres, min: 0.0, max: 0.4, default: SW_REF, couplings: &[],
         doc: "lateral distance between the feet's centre lines" },
-    AttrSpec { attr: Attr::KneeHeelStrike, name: "knee_heel_strike", unit: AttrUnit::Degrees, min: 0.0, max: 70.0 * D, default: 22.0 * D, couplings: &[],
+    AttrSpec { attr: Attr::KneeHeelStrike, name: "knee_heel_strike", unit: AttrUnit::Degrees, min: 0.0, max: 70.0 * D, default: 15.0 * D, couplings: &[],
         doc: "knee flexion at heel strike" },
     AttrSpec { attr: Attr::KneeToeOff, name: "knee_toe_off", unit: AttrUnit::Degrees, min: 0.0, max: 70.0 * D, default: 20.0 * D,
         couplings: &[Coupling { driver: Driver::StepLength, reference: SL_LONG, slope: -100.0 * D, range: (SL_SHORT, SL_LONG) }],
@@ -309,7 +309,7 @@ pub struct Effective {
 
 /// Hidden attribute: ankle dorsiflexion at toe off (rad) for a normalised step length (m).
 pub fn hidden_ankle_toe_off(sl_n: f64) -> f64 {
-    (-40.0 + 150.0 * (SL_LONG - sl_n.clamp(SL_SHORT, SL_LONG))) * D
+    (-36.0 + 150.0 * (SL_LONG - sl_n.clamp(SL_SHORT, SL_LONG))) * D
 }
 
 /// Hidden attribute: toe dorsiflexion at toe off (rad) for a normalised step length (m).

@@ -6,49 +6,58 @@
 //! are positive; knee flexion is stored as a positive number and applied as a negative rotation.
 use glam::{DMat3, DQuat, DVec2, DVec3};
 
-/// Lengths of the figure the running algorithm needs (metres).
+use crate::generator::anthropometry::Anthropometry;
+
+/// Lengths of the figure the running algorithm needs (metres), read from the shared
+/// [`Anthropometry`] (table B-1 of Bruderlin & Calvert 1989, scaled from body height) so that the
+/// generator's geometry and the skeleton's forward kinematics agree exactly.
 ///
-/// Built from body height with table B-1 of Bruderlin & Calvert (1989) (the walking paper), the
-/// anthropometry the running paper also uses (§4: "body height and relative limb lengths are
-/// variable").
+/// The foot: the ankle is `ankle_height` above the sole; the heel sole point `heel_back` behind
+/// it; the metatarsal (toe) joint `ankle_to_ball` ahead of it and `mtp_height` above the sole; the
+/// ball sole point is under the metatarsal joint and, like the toe tip (`toe` ahead of the joint
+/// on the sole), rides on the toe segment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunnerDims {
     /// Body height, m.
     pub body_height: f64,
-    /// Hip to knee, m (B-1 l3 = 0.23669 h).
+    /// Hip to knee, m.
     pub thigh: f64,
-    /// Knee to ankle, m (B-1 l4 = 0.24556 h).
+    /// Knee to ankle, m.
     pub shank: f64,
-    /// Ankle above the sole (foot base), m (B-1 l9 = 0.03846 h).
+    /// Ankle above the sole (foot base), m.
     pub ankle_height: f64,
-    /// Heel behind the ankle along the sole, m (from B-1 l11 heel–ankle distance 0.04853 h).
+    /// Heel behind the ankle along the sole, m.
     pub heel_back: f64,
-    /// Ball (first metatarsal joint, on the sole) ahead of the ankle, m (from B-1 l12 = 0.08901 h).
+    /// Metatarsal joint ahead of the ankle, m.
     pub ankle_to_ball: f64,
-    /// Ball to toe tip, m (B-1 l13 = 0.0496 h).
+    /// Metatarsal joint above the sole, m.
+    pub mtp_height: f64,
+    /// Metatarsal joint to toe tip along the sole, m.
     pub toe: f64,
     /// Right hip joint relative to the pelvis root, in the pelvis frame, m (the left hip is the
-    /// mirror image in z). B-1 gives the hip-to-hip width l0 = 0.10059 h.
+    /// mirror image in z).
     pub hip_offset: DVec3,
 }
 
 impl RunnerDims {
-    /// Dimensions for a figure of `body_height` metres from table B-1 of the walking paper, with
-    /// the pelvis root midway between the hip joints.
-    pub fn from_height(body_height: f64) -> Self {
-        let h = body_height;
-        let ankle_height = 0.03846 * h;
-        let horizontal = |dist: f64| (dist * dist - ankle_height * ankle_height).max(0.0).sqrt();
+    /// The dimensions of a figure with the given anthropometry.
+    pub fn from_anthropometry(a: &Anthropometry) -> Self {
         RunnerDims {
-            body_height: h,
-            thigh: 0.23669 * h,
-            shank: 0.24556 * h,
-            ankle_height,
-            heel_back: horizontal(0.04853 * h),
-            ankle_to_ball: horizontal(0.08901 * h),
-            toe: 0.0496 * h,
-            hip_offset: DVec3::new(0.0, 0.0, 0.5 * 0.10059 * h),
+            body_height: a.height_m,
+            thigh: a.thigh.length_m,
+            shank: a.shank.length_m,
+            ankle_height: a.foot.ankle_height_m,
+            heel_back: a.foot.hind_foot_m,
+            ankle_to_ball: a.foot.mid_foot_m,
+            mtp_height: a.foot.metatarsal_height_m,
+            toe: a.foot.toe_m,
+            hip_offset: DVec3::new(0.0, 0.0, 0.5 * a.hip_width_m),
         }
+    }
+
+    /// Dimensions for a figure of `body_height` m with the table proportions.
+    pub fn from_height(body_height: f64) -> Result<Self, crate::generator::GenerateError> {
+        Ok(Self::from_anthropometry(&Anthropometry::from_height(body_height, 70.0)?))
     }
 
     /// Heel to toe tip along the sole of a flat foot, m.
@@ -79,17 +88,21 @@ impl RunnerDims {
         DVec3::new(self.hip_offset.x, self.hip_offset.y, side_sign * self.hip_offset.z)
     }
 
-    /// Heel relative to the ankle in the foot frame (sagittal, flat foot).
+    /// Heel relative to the ankle in the foot frame (sagittal).
     pub fn heel_f(&self) -> DVec2 {
         DVec2::new(-self.heel_back, -self.ankle_height)
     }
-    /// Ball relative to the ankle in the foot frame.
-    pub fn ball_f(&self) -> DVec2 {
-        DVec2::new(self.ankle_to_ball, -self.ankle_height)
+    /// Metatarsal joint relative to the ankle in the foot frame.
+    pub fn mtp_f(&self) -> DVec2 {
+        DVec2::new(self.ankle_to_ball, self.mtp_height - self.ankle_height)
+    }
+    /// Ball relative to the ankle in the foot frame with the toes dorsiflexed by `m` rad.
+    pub fn ball_f(&self, m: f64) -> DVec2 {
+        self.mtp_f() + rot2(m, DVec2::new(0.0, -self.mtp_height))
     }
     /// Toe tip relative to the ankle in the foot frame with the toes dorsiflexed by `m` rad.
     pub fn toe_f(&self, m: f64) -> DVec2 {
-        self.ball_f() + self.toe * DVec2::new(m.cos(), m.sin())
+        self.mtp_f() + rot2(m, DVec2::new(self.toe, -self.mtp_height))
     }
 }
 
@@ -202,9 +215,13 @@ pub fn leg_fk(d: &RunnerDims, hip: DVec3, a: &LegAngles) -> LegPoints {
         ankle + DVec3::new(r.x, r.y, 0.0)
     };
     let heel = foot(d.heel_f());
-    let ball = foot(d.ball_f());
-    let t = rot2(fp + a.meta, DVec2::new(d.toe, 0.0));
-    let toe = ball + DVec3::new(t.x, t.y, 0.0);
+    let mtp = foot(d.mtp_f());
+    let on_toe = |v: DVec2| {
+        let r = rot2(fp + a.meta, v);
+        mtp + DVec3::new(r.x, r.y, 0.0)
+    };
+    let ball = on_toe(DVec2::new(0.0, -d.mtp_height));
+    let toe = on_toe(DVec2::new(d.toe, -d.mtp_height));
     LegPoints { hip, knee, ankle, heel, ball, toe }
 }
 
@@ -269,14 +286,18 @@ mod tests {
 
     #[test]
     fn b1_lengths_at_1_8_m() {
-        let d = RunnerDims::from_height(1.8);
+        let d = RunnerDims::from_height(1.8).unwrap();
         assert!((d.thigh - 0.426).abs() < 1e-3); // walking paper's own example: l3 = 0.426 m
-        assert!((d.foot_length() - 0.287).abs() < 1e-3);
+        // l8 + l5 + l6 of table B-1.
+        assert!((d.foot_length() - (0.02959 + 0.0858 + 0.04734) * 1.8).abs() < 1e-12);
+        // A flat foot has heel, ball and toe on the sole.
+        let p = leg_fk(&d, DVec3::new(0.0, d.leg_reach() + d.ankle_height, 0.0), &LegAngles::default());
+        assert!(p.heel.y.abs() < 1e-12 && p.ball.y.abs() < 1e-12 && p.toe.y.abs() < 1e-12);
     }
 
     #[test]
     fn ik_then_fk_reaches_the_ankle() {
-        let d = RunnerDims::from_height(1.75);
+        let d = RunnerDims::from_height(1.75).unwrap();
         let hip = DVec3::new(0.1, 0.9, 0.12);
         let ankle = DVec3::new(0.25, 0.08, 0.05);
         let (a, out) = leg_ik(&d, hip, ankle, 0.2, 0.1);

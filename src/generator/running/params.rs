@@ -24,6 +24,7 @@ use argmin::solver::brent::BrentRoot;
 
 use super::attributes::{Drivers, RunAttributes};
 use super::dims::RunnerDims;
+use crate::generator::skeleton::Skeleton;
 use super::equations::RunRelations;
 use super::state::{state_keyframes, FlightSpec, Footprint, StepInput};
 use crate::generator::GenerateError;
@@ -142,7 +143,9 @@ const SF_SEARCH: (f64, f64) = (60.0, 260.0);
 /// The figure and the relations a run is generated with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunModel {
-    /// Segment dimensions.
+    /// The figure.
+    pub skeleton: Skeleton,
+    /// Segment dimensions (from the skeleton's anthropometry).
     pub dims: RunnerDims,
     /// Eqs. 2, 4, 5 (published or refitted).
     pub relations: RunRelations,
@@ -200,10 +203,19 @@ impl CostFunction for HRoot<'_> {
 }
 
 impl RunModel {
-    /// A model with the published relations for a figure of `body_height` m (table B-1).
+    /// A model of `skeleton` driven by `relations`.
+    pub fn new(skeleton: Skeleton, relations: RunRelations) -> Result<Self, GenerateError> {
+        check_height(skeleton.anthropometry().height_m)?;
+        let dims = RunnerDims::from_anthropometry(skeleton.anthropometry());
+        Ok(RunModel { skeleton, dims, relations })
+    }
+
+    /// A model with the published relations for a figure of `body_height` m with table B-1
+    /// proportions (body mass, which running kinematics do not use, set to a BMI of 22.5).
     pub fn published(body_height: f64) -> Result<Self, GenerateError> {
         check_height(body_height)?;
-        Ok(RunModel { dims: RunnerDims::from_height(body_height), relations: RunRelations::published() })
+        let skeleton = Skeleton::from_height(body_height, default_mass(body_height))?;
+        RunModel::new(skeleton, RunRelations::published())
     }
 
     /// Steady-state flight: (H, t_flight) of a step with these parameters when the previous
@@ -435,6 +447,11 @@ impl Clone for HRoot<'_> {
     }
 }
 impl Copy for HRoot<'_> {}
+
+/// Body mass used when none is given, kg (BMI 22.5; running kinematics do not depend on it).
+pub fn default_mass(body_height: f64) -> f64 {
+    22.5 * body_height * body_height
+}
 
 fn check_speed(v: f64) -> Result<(), GenerateError> {
     if !(v >= SPEED_RANGE.0 && v <= SPEED_RANGE.1) {

@@ -137,9 +137,10 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
                 finish(fp.heel + DVec3::new(a.x, a.y, 0.0), pitch, 0.0, StanceMode::HeelPivot)
             }
             Strike::Toe => {
-                let ball = fp.heel + DVec3::new(d.heel_back + d.ankle_to_ball, 0.0, 0.0);
-                let a = rot2(pitch, DVec2::new(-d.ankle_to_ball, d.ankle_height));
-                finish(ball + DVec3::new(a.x, a.y, 0.0), pitch, -pitch, StanceMode::BallPivot)
+                // Toes flat: the foot rolls about the metatarsal joint, the ball stays put.
+                let mtp = fp.heel + DVec3::new(d.heel_back + d.ankle_to_ball, d.mtp_height, 0.0);
+                let a = rot2(pitch, d.mtp_f());
+                finish(mtp - DVec3::new(a.x, a.y, 0.0), pitch, -pitch, StanceMode::BallPivot)
             }
         };
     }
@@ -159,7 +160,7 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
     if let Some(a) = circle_sphere(toe, r_toe, hip2, r_hip) {
         let to_toe = toe - a;
         let pitch = to_toe.y.atan2(to_toe.x) - tf.y.atan2(tf.x);
-        let ball_y = a.y + rot2(pitch, d.ball_f()).y;
+        let ball_y = a.y + rot2(pitch, d.ball_f(m)).y;
         let heel_y = a.y + rot2(pitch, d.heel_f()).y;
         if ball_y >= -1e-9 && heel_y >= -1e-9 {
             return finish(DVec3::new(a.x, a.y, z), pitch, m, StanceMode::HeelOff);
@@ -169,8 +170,8 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
     // the knee angle is automatically temporarily increased" — the knee takes whatever flexion
     // puts the toes flat on the ground at the current toe angle; the foot pivots about the ball.
     let pitch = -m;
-    let ball = DVec2::new(toe.x - d.toe, 0.0);
-    let a = ball + rot2(pitch, DVec2::new(-d.ankle_to_ball, d.ankle_height));
+    let mtp = DVec2::new(toe.x - d.toe, d.mtp_height);
+    let a = mtp - rot2(pitch, d.mtp_f());
     finish(DVec3::new(a.x, a.y, z), pitch, m, StanceMode::HeelOffKneeRaised)
 }
 

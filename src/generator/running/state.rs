@@ -78,8 +78,7 @@ impl Footprint {
         let a = match self.strike {
             Strike::Heel => rot2(self.impact_pitch, DVec2::new(d.heel_back, d.ankle_height)),
             Strike::Toe => {
-                DVec2::new(d.heel_back + d.ankle_to_ball, 0.0)
-                    + rot2(self.impact_pitch, DVec2::new(-d.ankle_to_ball, d.ankle_height))
+                DVec2::new(d.heel_back + d.ankle_to_ball, d.mtp_height) - rot2(self.impact_pitch, d.mtp_f())
             }
         };
         self.heel + DVec3::new(a.x, a.y, 0.0)
@@ -1025,7 +1024,7 @@ mod tests {
 
     #[test]
     fn toe_off_radius_matches_forward_kinematics() {
-        let d = RunnerDims::from_height(1.8);
+        let d = RunnerDims::from_height(1.8).unwrap();
         let (k, a, m) = (0.35, -0.6, 0.5);
         let rad = toe_off_radius(&d, k, a, m, 0.0).unwrap();
         for pitch in [-0.5, -0.2, 0.1] {
@@ -1037,7 +1036,7 @@ mod tests {
 
     #[test]
     fn case_two_inverts_case_one() {
-        let d = RunnerDims::from_height(1.8);
+        let d = RunnerDims::from_height(1.8).unwrap();
         let attrs = RunAttributes::defaults(1.8);
         let v = 12.0 / 3.6;
         let sl = 1.0694;
