@@ -33,4 +33,12 @@ pub enum GenerateError {
         /// Details.
         message: String,
     },
+    /// An input file of a generator (e.g. a per-step schedule) is unreadable or malformed.
+    #[error("{path}: {message}")]
+    Input {
+        /// The file.
+        path: String,
+        /// Where (row, column) and what is wrong, and the remedy.
+        message: String,
+    },
 }

@@ -80,6 +80,10 @@ pub fn eval_frame(plan: &StepPlan, d: &RunnerDims, t: f64, pose: &mut Pose) -> F
     let (sw_ang, sw_pts, sw_contact, sw_role) = if plan.kind == StepKind::Stop {
         let (a, p, c) = stop_swing(plan, d, t, hip_sw);
         (a, p, c, if c { LegRole::Stance } else { LegRole::Swing })
+    } else if plan.kind == StepKind::Start && t < plan.stop.t_land {
+        let (ankle, _) = plan.stop.ankle[0].eval(t);
+        let (a, _) = leg_ik(d, hip_sw, ankle, 0.0, 0.0);
+        (a, leg_fk(d, hip_sw, &a), t <= 0.0, LegRole::Swing)
     } else {
         let (a, _) = plan.swing.eval(t);
         let role = if t <= plan.t_stance { LegRole::Swing } else { LegRole::Front };

@@ -391,12 +391,23 @@ pub fn toe_under_knee(d: &RunnerDims, pitch: f64, ankle: f64) -> f64 {
     (pitch - shank).max(0.0)
 }
 
+/// Minimum height of the swing foot's lowest point at the other leg's toe off, m at 1.8 m.
+pub const TOR_CLEARANCE: f64 = 0.03;
+/// Fraction of the stance leg's initial joint rates the landing leg arrives with (0: the
+/// joints stop at impact; 1: C1 through impact, the heel touching down tangentially).
+pub const HS_RATE_MATCH: f64 = 0.6;
+
+/// Fraction of the first support during which the swing foot is lifted off from the stand.
+pub const START_LIFT_FRACTION: f64 = 0.4;
+/// How high the swing foot is lifted from the stand by then, m at 1.8 m.
+pub const START_LIFT: f64 = 0.04;
+
 /// Standing: knee flexion used for the initial and final stands, rad.
 pub const STAND_KNEE: f64 = 6.0 * std::f64::consts::PI / 180.0;
 
 /// The standing pose both the start and the stop use: feet flat side by side (heels at
 /// `heel_x`, stride width apart), pelvis centred above the ankles.
-pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance_sign: f64) -> Carry {
+pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance_sign: f64, max_pelvis_y: f64) -> Carry {
     let s = first_stance_sign;
     let print = |sign: f64| Footprint {
         heel: DVec3::new(heel_x, 0.0, sign * eff.stride_width / 2.0),
@@ -408,7 +419,7 @@ pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance
     let x = heel_x + d.heel_back;
     let dz = d.hip_offset.z - eff.stride_width / 2.0;
     let dd = d.hip_ankle(STAND_KNEE);
-    let y = d.ankle_height + (dd * dd - dz * dz).max(0.0).sqrt() - d.hip_offset.y;
+    let y = (d.ankle_height + (dd * dd - dz * dz).max(0.0).sqrt() - d.hip_offset.y).min(max_pelvis_y);
     let pelvis = DVec3::new(x, y, 0.0);
     let hip = pelvis + d.hip_local(-s);
     let (swing, _) = leg_ik(d, hip, other.flat_ankle(d), 0.0, 0.0);
@@ -689,10 +700,42 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     // --- Swing leg (§3.3.1) and front leg in flight (§3.3.2). ---
     let sw = -s;
     let mut swing = Track::new();
-    swing.push(Key { t: 0.0, val: carry.swing, rate: carry.swing_rate });
+    if kind == StepKind::Start {
+        // From a stand the swing foot is lifted off the ground first along a Cartesian ankle
+        // path (flat foot straight up and forward with the pelvis), with the leg from inverse
+        // kinematics; the swing track takes over from the pose and rates where the path ends.
+        let t_lift = START_LIFT_FRACTION * t_stance;
+        let scale = d.body_height / 1.8;
+        let a0 = plan.other_print.flat_ankle(d);
+        let (pl0, _) = pelvis_at(&plan, 0.0);
+        let (pl1, vl1) = pelvis_at(&plan, t_lift);
+        let a1 = a0 + DVec3::new(pl1.x - pl0.x, START_LIFT * scale, 0.0);
+        let v1 = DVec3::new(vl1.x, 0.5 * START_LIFT * scale / t_lift, 0.0);
+        plan.stop = StopPath {
+            ankle: [Seg3 { t0: 0.0, t1: t_lift, p0: a0, p1: a1, v0: DVec3::ZERO, v1 }; 2],
+            t_land: t_lift,
+            pitch0: 0.0,
+            meta0: 0.0,
+            print: plan.other_print,
+        };
+        let eps = 1e-4;
+        let pose_at = |t: f64| {
+            let hip = hip_of(&plan, d, t, sw);
+            let (ankle, _) = plan.stop.ankle[0].eval(t);
+            leg_ik(d, hip, ankle, 0.0, 0.0).0
+        };
+        let (q1, q0) = (pose_at(t_lift), pose_at(t_lift - eps));
+        let mut rate = LegAngles::default();
+        for c in 0..5 {
+            rate.set(c, (q1.get(c) - q0.get(c)) / eps);
+        }
+        swing.push(Key { t: t_lift, val: q1, rate });
+    } else {
+        swing.push(Key { t: 0.0, val: carry.swing, rate: carry.swing_rate });
+    }
     let roll_sw = carry.swing.roll;
     let ms_pose = LegAngles { pitch: 0.0, roll: roll_sw, knee: e.swing_knee, ankle: e.swing_ankle, meta: 0.0 };
-    let tor_pose = LegAngles {
+    let mut tor_pose = LegAngles {
         pitch: e.swing_hip,
         roll: roll_sw,
         knee: toe_under_knee(d, e.swing_hip, e.swing_ankle),
@@ -701,6 +744,30 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     };
     let hip2 = p2 + o2;
     let hs = hs_pose(d, &next_print, hip2);
+    // The swing leg's toe-under-knee pose can leave the toe on the ground when the pelvis is low
+    // at toe off (slow runs, short bent-knee push-offs): then the swing hip is flexed further
+    // (keeping the toe under the knee) until the foot clears — the foot-stubbing recovery
+    // applied to the keyframe itself, so the flight starts from a clear foot.
+    let hip_tor = hip_of(&plan, d, t_stance, -s);
+    let need = TOR_CLEARANCE * d.body_height / 1.8;
+    if std::env::var("RDEBUG").is_ok() {
+        eprintln!("TOR hip {:?} pose {:?} lowest {:.4} need {need:.4} pts {:?}", hip_tor, tor_pose, leg_fk(d, hip_tor, &tor_pose).lowest(), leg_fk(d, hip_tor, &tor_pose));
+    }
+    while leg_fk(d, hip_tor, &tor_pose).lowest() < need && tor_pose.pitch < 100f64.to_radians() {
+        tor_pose.pitch += 2f64.to_radians();
+        tor_pose.knee = toe_under_knee(d, tor_pose.pitch, tor_pose.ankle);
+        plan.report.clearance_keys += 1;
+    }
+    // Landing: the front leg arrives with HS_RATE_MATCH of the joint rates the stance leg
+    // starts with (hip moving with the landing velocity over the planted foot), so the joints
+    // do not jerk at impact while the heel still comes down onto the ground.
+    let v_land = flight_v - DVec3::new(0.0, G * t_flight, 0.0);
+    let eps = 1e-4;
+    let hs_next = hs_pose(d, &next_print, hip2 + v_land * eps);
+    let mut hs_rate = LegAngles::default();
+    for c in 0..5 {
+        hs_rate.set(c, HS_RATE_MATCH * (hs_next.get(c) - hs.get(c)) / eps);
+    }
     if kind != StepKind::Start {
         let mut rate = LegAngles::default();
         rate.pitch = (tor_pose.pitch - carry.swing.pitch) / t_stance;
@@ -708,12 +775,11 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         swing.push(Key { t: t_ms, val: ms_pose, rate });
     }
     let mut rate = LegAngles::default();
-    let t_prev = if kind == StepKind::Start { 0.0 } else { t_ms };
-    let prev = if kind == StepKind::Start { carry.swing } else { ms_pose };
+    let (t_prev, prev) = if kind == StepKind::Start { (swing.start(), swing.keys()[0].val) } else { (t_ms, ms_pose) };
     rate.knee = (hs.knee - prev.knee) / (t_step - t_prev);
     rate.ankle = (hs.ankle - prev.ankle) / (t_step - t_prev);
     swing.push(Key { t: t_stance, val: tor_pose, rate });
-    swing.push(Key { t: t_step, val: hs, rate: LegAngles::default() });
+    swing.push(Key { t: t_step, val: hs, rate: hs_rate });
 
     // --- Hind leg in flight: toward p of the next mid-support pose (§3.3.2). ---
     let ne = inp.next_eff;
@@ -739,7 +805,8 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     // Recovery 3 (§3.3.1): toe stubbing — insert control points with more knee flexion.
     let margin = 0.01 * d.body_height / 1.8;
     let start = kind == StepKind::Start;
-    plan.report.clearance_keys += clear_track(&mut plan, d, sw, false, 0.0, t_step, start, true, margin);
+    let t_sw0 = plan.swing.start();
+    plan.report.clearance_keys += clear_track(&mut plan, d, sw, false, t_sw0, t_step, start, true, margin);
     plan.report.clearance_keys += clear_track(&mut plan, d, s, true, t_stance, t_step, true, false, margin);
     Ok(plan)
 }
@@ -887,6 +954,9 @@ fn clear_track(
         val.knee += lift;
         let mut key = Key { t, val, rate };
         key.rate.knee = rate.knee;
+        if std::env::var("RDEBUG").is_ok() {
+            eprintln!("clear hind={hind} t={t:.4} deficit {:.4} lift {:.3}", worst.0, lift.to_degrees());
+        }
         if track.keys().iter().any(|k| (k.t - t).abs() < 1e-6) || !track.insert(key) {
             break;
         }
@@ -1042,7 +1112,7 @@ mod tests {
         let sl = 1.0694;
         let sf = v / sl;
         let eff = attrs.effective(&Drivers { speed: v, step_length: sl, step_freq: sf, flight_height: 0.004 });
-        let mut carry = standing_carry(&d, &eff, 0.0, 1.0);
+        let mut carry = standing_carry(&d, &eff, 0.0, 1.0, f64::INFINITY);
         carry.standing = false;
         carry.pelvis_vel = DVec3::new(v, -1.0, 0.0);
         let inp = StepInput { speed: v, step_length: sl, step_freq: sf, flight: FlightSpec::Time(0.188), eff, next_eff: eff, p: 0.75 };
