@@ -77,11 +77,51 @@ pub struct Key {
 /// Maximum keys in one track (the recovery procedures insert a few).
 pub const MAX_KEYS: usize = 10;
 
-/// A piecewise cubic Hermite track of leg angles (C1 through its keys).
+/// A temporary extra knee flexion on a track (the foot-stubbing recovery's control point):
+/// rises smoothly from 0 at `t0` to `amount` at `peak` and falls back to 0 at `t1`, with zero
+/// slope at all three, so the track stays C1 and its end keys are untouched.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct KneeBump {
+    /// Start, s.
+    pub t0: f64,
+    /// Time of the maximum, s.
+    pub peak: f64,
+    /// End, s.
+    pub t1: f64,
+    /// Extra knee flexion at the peak, rad.
+    pub amount: f64,
+    /// Hold the peak to the end instead of returning to zero (the hind leg in flight, whose
+    /// track hands its end state to the next step's swing).
+    pub hold: bool,
+}
+
+impl KneeBump {
+    /// Extra flexion and its rate at `t`.
+    #[inline]
+    pub fn eval(&self, t: f64) -> (f64, f64) {
+        if self.amount == 0.0 || t <= self.t0 {
+            return (0.0, 0.0);
+        }
+        if self.hold && t >= self.peak {
+            return (self.amount, 0.0);
+        }
+        if t >= self.t1 {
+            return (0.0, 0.0);
+        }
+        let (a, b, up) = if t <= self.peak { (self.t0, self.peak, true) } else { (self.peak, self.t1, false) };
+        let (p0, p1) = if up { (0.0, self.amount) } else { (self.amount, 0.0) };
+        hermite(a, b, p0, p1, 0.0, 0.0, t)
+    }
+}
+
+/// A piecewise cubic Hermite track of leg angles (C1 through its keys), plus an optional knee
+/// bump.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Track {
     keys: [Key; MAX_KEYS],
     len: usize,
+    /// Foot-stubbing recovery on this track.
+    pub bump: KneeBump,
 }
 
 impl Track {
@@ -152,6 +192,9 @@ impl Track {
             v.set(c, x);
             r.set(c, dx);
         }
+        let (bk, br) = self.bump.eval(t);
+        v.knee += bk;
+        r.knee += br;
         (v, r)
     }
 }

@@ -7,7 +7,7 @@ use super::curves::hermite;
 use super::dims::{leg_fk, leg_ik, leg_orientations, pelvis_orientation, LegAngles, LegPoints, RunnerDims};
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
 use super::state::{StepKind, StepPlan};
-use super::upper_body::{arm_driver, fill_upper, LegRole};
+use super::upper_body::{arm_beta, arm_driver, fill_upper};
 use crate::generator::skeleton::{Joint, Pose};
 
 /// Per-frame facts besides the pose.
@@ -66,28 +66,25 @@ pub fn eval_frame(plan: &StepPlan, d: &RunnerDims, t: f64, pose: &mut Pose) -> F
     let hip_st = hip_at(d, pelvis, yaw, roll, s);
     let hip_sw = hip_at(d, pelvis, yaw, roll, -s);
     let in_support = plan.kind == StepKind::Stop || t <= plan.t_stance;
-    let flight_progress = if plan.t_flight > 0.0 { (t - plan.t_stance) / plan.t_flight } else { 0.0 };
 
     // Stance leg: phase constraints while on the ground, hind-leg track in flight.
-    let (st_ang, st_pts, st_role, mode, out) = if in_support {
+    let (st_ang, st_pts, mode, out) = if in_support {
         let e = stance_leg(plan, d, t, hip_st);
-        (e.angles, e.points, LegRole::Stance, Some(e.mode), e.out_of_reach)
+        (e.angles, e.points, Some(e.mode), e.out_of_reach)
     } else {
         let (a, _) = plan.hind.eval(t);
-        (a, leg_fk(d, hip_st, &a), LegRole::Hind, None, false)
+        (a, leg_fk(d, hip_st, &a), None, false)
     };
     // Swing leg.
-    let (sw_ang, sw_pts, sw_contact, sw_role) = if plan.kind == StepKind::Stop {
-        let (a, p, c) = stop_swing(plan, d, t, hip_sw);
-        (a, p, c, if c { LegRole::Stance } else { LegRole::Swing })
+    let (sw_ang, sw_pts, sw_contact) = if plan.kind == StepKind::Stop {
+        stop_swing(plan, d, t, hip_sw)
     } else if plan.kind == StepKind::Start && t < plan.stop.t_land {
         let (ankle, _) = plan.stop.ankle[0].eval(t);
         let (a, _) = leg_ik(d, hip_sw, ankle, 0.0, 0.0);
-        (a, leg_fk(d, hip_sw, &a), t <= 0.0, LegRole::Swing)
+        (a, leg_fk(d, hip_sw, &a), t <= 0.0)
     } else {
         let (a, _) = plan.swing.eval(t);
-        let role = if t <= plan.t_stance { LegRole::Swing } else { LegRole::Front };
-        (a, leg_fk(d, hip_sw, &a), plan.kind == StepKind::Start && t <= 0.0, role)
+        (a, leg_fk(d, hip_sw, &a), plan.kind == StepKind::Start && t <= 0.0)
     };
 
     pose.root = pelvis;
@@ -107,8 +104,8 @@ pub fn eval_frame(plan: &StepPlan, d: &RunnerDims, t: f64, pose: &mut Pose) -> F
     }
 
     let mut drivers = [0.0; 2];
-    drivers[idx(s)] = arm_driver(st_role, &st_ang, &st_pts, flight_progress);
-    drivers[idx(-s)] = arm_driver(sw_role, &sw_ang, &sw_pts, flight_progress);
+    drivers[idx(s)] = arm_driver(&st_ang, &st_pts, arm_beta(plan, t, true));
+    drivers[idx(-s)] = arm_driver(&sw_ang, &sw_pts, arm_beta(plan, t, false));
     fill_upper(plan, t, yaw, roll, drivers, pose);
 
     let mut info = FrameInfo {

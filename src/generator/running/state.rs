@@ -16,7 +16,7 @@ use glam::{DVec2, DVec3};
 use nalgebra::{Matrix2, Vector2};
 
 use super::attributes::{Effective, Strike};
-use super::curves::{c2_mid_velocity, Key, Seg3, Track};
+use super::curves::{c2_mid_velocity, Key, KneeBump, Seg3, Track};
 use super::dims::{leg_fk, leg_ik, pelvis_matrix, pitch_from_down, rot2, LegAngles, RunnerDims};
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
 use crate::generator::GenerateError;
@@ -134,6 +134,8 @@ pub struct Carry {
     pub upper: UpperAttrs,
     /// Hip–ankle pitch of a leg at toe off (the back end of the arm swing), rad.
     pub arm_back: f64,
+    /// Maximum swing hip flexion (the front end of the arm swing), rad.
+    pub arm_front: f64,
 }
 
 /// Inputs of one step: the parameters and effective attributes in force.
@@ -270,6 +272,8 @@ pub struct StepPlan {
     pub sway: [(f64, f64); 4],
     /// Arm-swing back end at the start of the step and for this step, rad.
     pub arm_back: (f64, f64),
+    /// Arm-swing front end at the start of the step and for this step, rad.
+    pub arm_front: (f64, f64),
     /// Speed, m/s.
     pub speed: f64,
     /// Step length, m.
@@ -397,10 +401,25 @@ pub const TOR_CLEARANCE: f64 = 0.03;
 /// joints stop at impact; 1: C1 through impact, the heel touching down tangentially).
 pub const HS_RATE_MATCH: f64 = 0.6;
 
+/// Shortest time over which a swinging foot's required clearance grows from zero (after toe
+/// off) or shrinks to zero (before heel strike), s.
+pub const CLEARANCE_RAMP: f64 = 0.1;
+
+/// The flight's share of the time from toe off to the next mid-support at the paper's
+/// reference stride (12 km/h, 1.8 m: 0.188 s of 0.254 s), for which p ∈ [0.6, 0.9] was tuned.
+pub const P_REFERENCE_SHARE: f64 = 0.74;
+
 /// Fraction of the first support during which the swing foot is lifted off from the stand.
 pub const START_LIFT_FRACTION: f64 = 0.4;
 /// How high the swing foot is lifted from the stand by then, m at 1.8 m.
 pub const START_LIFT: f64 = 0.04;
+
+/// How far ahead of the stance ankle the pelvis comes to rest at a stop, m at 1.8 m.
+pub const STOP_STAGGER: f64 = 0.1;
+/// Knee flexion of the final stand, rad.
+pub const STOP_KNEE: f64 = 15.0 * std::f64::consts::PI / 180.0;
+/// Longest stop phase, s at 1.8 m.
+pub const STOP_TIME: f64 = 0.6;
 
 /// Standing: knee flexion used for the initial and final stands, rad.
 pub const STAND_KNEE: f64 = 6.0 * std::f64::consts::PI / 180.0;
@@ -437,6 +456,7 @@ pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance
         sway_phase: 1.5 * std::f64::consts::PI, // cos = 0: upright, rising to the forward maximum
         upper: [0.0, 0.0, 0.0, eff.elbow_min, eff.elbow_min, 0.0, eff.arm_abduction],
         arm_back: 0.0,
+        arm_front: 0.0,
     }
 }
 
@@ -445,15 +465,23 @@ fn hs_pose(d: &RunnerDims, print: &Footprint, hip: DVec3) -> LegAngles {
 }
 
 /// Required clearance of a swinging foot at time `t` of a window [t_a, t_b] that starts
-/// (`ramp_in`) and/or ends (`ramp_out`) at a ground contact.
+/// (`ramp_in`) and/or ends (`ramp_out`) at a ground contact: `margin`, ramped smoothly from zero
+/// over the first/last quarter of the window (a foot leaves and reaches the ground with the
+/// joint rates of the neighbouring phase, so its height grows from zero smoothly).
 fn required_clearance(t: f64, t_a: f64, t_b: f64, ramp_in: bool, ramp_out: bool, margin: f64) -> f64 {
-    const LIFT: f64 = 0.25; // m/s: how fast a foot must at least leave or approach the ground
+    // A quarter of the window, but at least CLEARANCE_RAMP: short flights (slow runs) need not
+    // lift the foot a full margin within a few milliseconds.
+    let q = (0.25 * (t_b - t_a)).max(CLEARANCE_RAMP);
+    let ramp = |tau: f64| {
+        let s = (tau / q).clamp(0.0, 1.0);
+        s * s * (3.0 - 2.0 * s)
+    };
     let mut r = margin;
     if ramp_in {
-        r = r.min(LIFT * (t - t_a));
+        r = r.min(margin * ramp(t - t_a));
     }
     if ramp_out {
-        r = r.min(LIFT * (t_b - t));
+        r = r.min(margin * ramp(t_b - t));
     }
     r
 }
@@ -642,6 +670,7 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         upper0: carry.upper,
         sway: [(0.0, carry.sway_phase), (t_ms, std::f64::consts::TAU), (t_stance, 3.0 * std::f64::consts::PI), (t_step, 0.0)],
         arm_back: (carry.arm_back, carry.arm_back),
+        arm_front: (carry.arm_front, e.swing_hip),
         speed: v,
         step_length: sl,
         step_freq: sf,
@@ -680,9 +709,21 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     // The mid-support point is the low point of support (§3.2: energies lowest there).
     y_ms = y_ms.min(y_low - 0.002 * d.body_height / 1.8);
     let lower_by = 0.01 * d.body_height / 1.8;
+    // The hind leg's flight target (§3.3.2): p is the fraction of the way to the next
+    // mid-support pose reached at heel strike. The paper's 0.6–0.9 suit its long flights (at
+    // 12 km/h the flight is 74 % of the time from toe off to the next mid-support); for shorter
+    // flights p is scaled by the flight's share of that time, or a slow run's 50 ms flight would
+    // whip the leg through most of its swing.
+    let share = t_flight / (t_flight + t_ms);
+    let p_eff = inp.p * (share / P_REFERENCE_SHARE).min(1.0);
+    plan.report.p = p_eff;
+    // The push-off ends with the knee already folding toward that target (real knees flex
+    // before toe off), so the hind leg leaves the ground C1 and its toe lifts.
+    let knee_target = e.knee_toe_off + p_eff * (inp.next_eff.swing_knee - e.knee_toe_off);
+    let kr_to = 0.5 * (knee_target - e.knee_toe_off) / t_flight;
     loop {
         build_support(&mut plan, kind, p0, carry.pelvis_vel, DVec3::new(x_ms, y_ms, z_ms), p1, flight_v);
-        find_heel_off(&mut plan, d);
+        find_heel_off(&mut plan, d, kr_to);
         let ok = stance_reachable(&plan, d);
         if ok || kind == StepKind::Start || plan.report.mid_support_lowered >= 12 {
             plan.report.out_of_reach = !ok;
@@ -788,16 +829,13 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     let mut end_rate = LegAngles::default();
     for c in 0..5 {
         let (a, b) = (to_pose.get(c), next_ms.get(c));
-        let tv = a + inp.p * (b - a);
+        let tv = a + p_eff * (b - a);
         target.set(c, tv);
         end_rate.set(c, (b - tv) / t_ms.max(1e-3));
     }
     let mut hind = Track::new();
-    // The knee starts folding at once: its rate leaving the ground is set to the average needed
-    // to reach the target, not the (extending) push-off rate, so the toe lifts clear.
-    let mut start_rate = to_rate;
-    start_rate.knee = start_rate.knee.max(1.5 * (target.knee - to_pose.knee) / t_flight);
-    hind.push(Key { t: t_stance, val: to_pose, rate: start_rate });
+    // The hind leg leaves the ground with the push-off's joint rates (C1 through toe off).
+    hind.push(Key { t: t_stance, val: to_pose, rate: to_rate });
     hind.push(Key { t: t_step, val: target, rate: end_rate });
     plan.swing = swing;
     plan.hind = hind;
@@ -836,7 +874,7 @@ fn hip_of(plan: &StepPlan, d: &RunnerDims, t: f64, sign: f64) -> DVec3 {
 /// vertical or the ankle-hip distance becoming bigger than the length of the extended leg". The
 /// vertical is read as the hip passing over the ankle. If neither happens, heel off is forced
 /// so that the last quarter of the flat-to-toe-off time is left for the push-off.
-fn find_heel_off(plan: &mut StepPlan, d: &RunnerDims) {
+fn find_heel_off(plan: &mut StepPlan, d: &RunnerDims, kr_to: f64) {
     let s = plan.s;
     let ankle = plan.stance_print.flat_ankle(d);
     let reach = d.leg_reach();
@@ -883,7 +921,7 @@ fn find_heel_off(plan: &mut StepPlan, d: &RunnerDims) {
         k0: a0.knee,
         k1: plan.eff.knee_toe_off,
         kr0,
-        kr1: (plan.eff.knee_toe_off - a0.knee) / dur,
+        kr1: ((plan.eff.knee_toe_off - a0.knee) / dur).max(kr_to),
         m1: plan.eff.meta_toe_off,
         mr1: plan.eff.meta_toe_off / dur,
     };
@@ -914,8 +952,10 @@ fn stance_state(plan: &StepPlan, d: &RunnerDims, t: f64) -> (LegAngles, LegAngle
     (now.angles, rate, pitch_from_down(DVec2::new(ha.x, ha.y)))
 }
 
-/// Checks a swinging foot's clearance on a track over [t_a, t_b] and inserts control points with
-/// more knee flexion where it stubs the ground (§3.3.1's recovery). Returns keys inserted.
+/// Checks a swinging foot's clearance on a track over [t_a, t_b] and, where it stubs the
+/// ground, adds a temporary knee flexion peaking at the worst instant (§3.3.1's recovery:
+/// "inserts a new control point with temporarily increased knee flexion"), raised until the
+/// foot clears. Returns the number of raises.
 #[allow(clippy::too_many_arguments)]
 fn clear_track(
     plan: &mut StepPlan,
@@ -928,41 +968,53 @@ fn clear_track(
     ramp_out: bool,
     margin: f64,
 ) -> u32 {
-    let mut inserted = 0;
     let n = 40;
-    for _ in 0..4 {
+    let worst = |plan: &StepPlan| {
         let track = if hind { &plan.hind } else { &plan.swing };
         let mut worst = (0.0, 0.0); // (deficit, t)
         for i in 1..n {
             let t = t_a + (t_b - t_a) * i as f64 / n as f64;
             let (ang, _) = track.eval(t);
             let pts = leg_fk(d, hip_of(plan, d, t, sign), &ang);
-            let need = required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin);
-            let deficit = need - pts.lowest();
+            // Half a millimetre of slack: the generator's own penetration bound is 1 mm.
+            let deficit = required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.0005;
             if deficit > worst.0 {
                 worst = (deficit, t);
             }
         }
-        if worst.0 <= 0.0 {
-            break;
-        }
-        let t = worst.1;
-        let track = if hind { &mut plan.hind } else { &mut plan.swing };
-        let (mut val, rate) = track.eval(t);
-        // Raise the knee by what lifts the foot by the deficit (shank ≈ lever), at least 5°.
-        let lift = (worst.0 / (0.5 * d.shank)).max(5f64.to_radians());
-        val.knee += lift;
-        let mut key = Key { t, val, rate };
-        key.rate.knee = rate.knee;
-        if std::env::var("RDEBUG").is_ok() {
-            eprintln!("clear hind={hind} t={t:.4} deficit {:.4} lift {:.3}", worst.0, lift.to_degrees());
-        }
-        if track.keys().iter().any(|k| (k.t - t).abs() < 1e-6) || !track.insert(key) {
-            break;
-        }
-        inserted += 1;
+        worst
+    };
+    let (deficit, t_worst) = worst(plan);
+    if deficit <= 0.0 || std::env::var("RNOBUMP").is_ok() {
+        return 0;
     }
-    inserted
+    // The bump's peak is kept off the window's ends so the extra flexion builds up smoothly.
+    // A held bump (hind leg) may peak after the window: the next step inherits its value and
+    // rate.
+    let t_peak = if hind {
+        t_worst.max(t_a + 0.5 * (t_b - t_a))
+    } else {
+        t_worst.clamp(t_a + 0.3 * (t_b - t_a), t_b - 0.3 * (t_b - t_a))
+    };
+    let mut raises = 0;
+    let mut deficit = deficit;
+    let lever = 0.5 * d.shank;
+    while deficit > 0.0 && raises < 16 {
+        let track = if hind { &mut plan.hind } else { &mut plan.swing };
+        track.bump = KneeBump {
+            t0: t_a,
+            peak: t_peak,
+            t1: t_b,
+            amount: track.bump.amount + (deficit / lever).max(3f64.to_radians()),
+            hold: hind,
+        };
+        raises += 1;
+        deficit = worst(plan).0;
+    }
+    if std::env::var("RDEBUG").is_ok() {
+        eprintln!("clear hind={hind} peak {t_peak:.4} raises {raises} left {deficit:.4}");
+    }
+    raises
 }
 
 /// The state at the end of a planned running step (the next heel strike).
@@ -987,6 +1039,7 @@ pub fn carry_out(plan: &StepPlan, d: &RunnerDims) -> Carry {
         sway_phase: plan.sway[3].1,
         upper: upper_attrs(&plan.eff),
         arm_back: plan.arm_back.1,
+        arm_front: plan.arm_front.1,
     }
 }
 
@@ -996,29 +1049,40 @@ pub fn carry_out(plan: &StepPlan, d: &RunnerDims) -> Carry {
 /// phases for this leg are extended until HSL") is replaced by this; see the module docs.
 pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     let s = carry.stance_sign;
-    let scale = (d.body_height / 1.8).sqrt();
+    let scale = d.body_height / 1.8;
     let v0 = carry.pelvis_vel.x.max(0.0);
-    let t_stop = (0.45 + 0.12 * v0) * scale;
     let fp = carry.stance_print;
     let stance_ankle = fp.flat_ankle(d);
-    // Pelvis comes to rest ahead of the landing point: far enough for x to stay monotone with a
-    // zero final velocity (Δx ≥ v·T/3), and the other foot lands as far ahead of the pelvis as
-    // the stance ankle is behind it.
+    // The pelvis comes to rest STOP_STAGGER ahead of the stance ankle (the other foot lands as
+    // far ahead of the pelvis, a short staggered stand). The stop lasts as long as a cubic with
+    // the landing speed and zero final speed can take without moving backwards (Δx ≥ v·T/3),
+    // capped at STOP_TIME.
+    let x_end = stance_ankle.x + STOP_STAGGER * scale;
+    let dx_total = (x_end - carry.pelvis.x).max(0.02 * scale);
+    let t_stop = if v0 > 1e-6 { (2.9 * dx_total / v0).min(STOP_TIME * scale.sqrt()) } else { STOP_TIME * scale.sqrt() }.max(0.25);
     let dz = d.hip_offset.z - eff.stride_width / 2.0;
-    let dd = d.hip_ankle(STAND_KNEE.max(12f64.to_radians()));
-    let max_dx = (dd * dd - dz * dz - (0.8 * d.leg_reach()).powi(2)).max(0.0).sqrt();
-    let x_end = (carry.pelvis.x + 0.4 * v0 * t_stop).clamp(stance_ankle.x, stance_ankle.x + max_dx);
-    let dx = x_end - stance_ankle.x;
+    // Come to rest with the knees a little bent, so both legs reach the ground throughout.
+    let dd = d.hip_ankle(STOP_KNEE);
+    let dx = STOP_STAGGER * scale;
     let y_hip = d.ankle_height + (dd * dd - dz * dz - dx * dx).max(0.0).sqrt();
-    let y_end = (y_hip - d.hip_offset.y).min(carry.pelvis.y);
+    let y_end = y_hip - d.hip_offset.y;
     let p_end = DVec3::new(x_end, y_end, 0.0);
     let final_print = Footprint {
         heel: DVec3::new(2.0 * x_end - stance_ankle.x - d.heel_back, 0.0, -s * eff.stride_width / 2.0),
         strike: eff.strike,
         impact_pitch: 0.0,
     };
-    let support = Seg3 { t0: 0.0, t1: t_stop, p0: carry.pelvis, p1: p_end, v0: carry.pelvis_vel, v1: DVec3::ZERO };
-    let t_flat = (0.12 * scale).min(0.4 * t_stop);
+    // Two spline segments like a support phase: through a mid-support point over the stance
+    // foot (lateral displacement toward it, as in Fig. 7) to rest centred between the feet.
+    let lat = eff.lateral_displacement;
+    let mut p_mid = DVec3::new(0.5 * (carry.pelvis.x + x_end), carry.pelvis.y.min(y_end), s * lat);
+    let h = 0.5 * t_stop;
+    let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
+    let support = [
+        Seg3 { t0: 0.0, t1: h, p0: carry.pelvis, p1: p_mid, v0: carry.pelvis_vel, v1: v_mid },
+        Seg3 { t0: h, t1: t_stop, p0: p_mid, p1: p_end, v0: v_mid, v1: DVec3::ZERO },
+    ];
+    let t_flat = (0.12 * scale.sqrt()).min(0.4 * t_stop);
     let mut plan = StepPlan {
         kind: StepKind::Stop,
         s,
@@ -1028,8 +1092,8 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         t_ms: 0.5 * t_stop,
         t_flat,
         t_heel_off: t_stop,
-        support: [support, support],
-        nseg: 1,
+        support,
+        nseg: 2,
         flight_p1: p_end,
         flight_v: DVec3::ZERO,
         orient: [(0.0, carry.yaw, carry.roll), (0.5 * t_stop, 0.0, 0.0), (t_stop, 0.0, 0.0), (t_stop, 0.0, 0.0)],
@@ -1044,12 +1108,24 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         upper0: carry.upper,
         sway: [(0.0, carry.sway_phase), (t_stop, carry.sway_phase), (t_stop, carry.sway_phase), (t_stop, carry.sway_phase)],
         arm_back: (carry.arm_back, carry.arm_back),
+        arm_front: (carry.arm_front, carry.arm_front),
         speed: 0.0,
         step_length: 0.0,
         step_freq: 0.0,
         stop: StopPath::default(),
         report: StepReport { t_stance: t_stop, ..StepReport::default() },
     };
+    // Recovery 1 as in a running step: lower the mid-support point while the stance hip is
+    // out of reach.
+    while !stance_reachable(&plan, d) && plan.report.mid_support_lowered < 12 {
+        p_mid.y -= 0.01 * scale;
+        let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
+        plan.support = [
+            Seg3 { t0: 0.0, t1: h, p0: carry.pelvis, p1: p_mid, v0: carry.pelvis_vel, v1: v_mid },
+            Seg3 { t0: h, t1: t_stop, p0: p_mid, p1: p_end, v0: v_mid, v1: DVec3::ZERO },
+        ];
+        plan.report.mid_support_lowered += 1;
+    }
     // The swing foot: ankle from where it is now, up and forward, down onto its footprint.
     let hip0 = hip_at(d, carry.pelvis, carry.yaw, carry.roll, -s);
     let pts0 = leg_fk(d, hip0, &carry.swing);
@@ -1061,7 +1137,7 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     let hip_e = hip_at(d, carry.pelvis + e * carry.pelvis_vel, carry.yaw, carry.roll, -s);
     let va0 = (leg_fk(d, hip_e, &ahead).ankle - pts0.ankle) / e;
     let land = final_print.flat_ankle(d);
-    let t_land = 0.75 * t_stop;
+    let t_land = 0.8 * t_stop;
     let mid = DVec3::new(
         0.5 * (pts0.ankle.x + land.x),
         pts0.ankle.y.max(land.y) + 0.06 * d.body_height / 1.8,

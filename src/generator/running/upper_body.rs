@@ -17,19 +17,6 @@ use super::dims::{pitch_from_down, LegAngles, LegPoints};
 use super::state::{StepKind, StepPlan, UpperAttrs};
 use crate::generator::skeleton::{Joint, Pose};
 
-/// What a leg is doing at an instant (for the arm-swing driver).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LegRole {
-    /// On the ground.
-    Stance,
-    /// Swinging during the other leg's support.
-    Swing,
-    /// Hind leg in flight (just left the ground).
-    Hind,
-    /// Front leg in flight (about to land).
-    Front,
-}
-
 #[inline]
 fn smooth01(s: f64) -> f64 {
     let s = s.clamp(0.0, 1.0);
@@ -41,19 +28,29 @@ fn world(yaw: f64, roll: f64, pitch: f64) -> DQuat {
     DQuat::from_rotation_y(yaw) * DQuat::from_rotation_x(roll) * DQuat::from_rotation_z(pitch)
 }
 
-/// The arm-swing driver of one leg (rad, positive forward): thigh pitch while it swings
-/// forward, hip–ankle pitch while it is on the ground; in flight one blends into the other so
-/// the arm never jumps.
+/// The arm-swing driver of one leg (rad, positive forward): §3.3.3 drives the forward swing of
+/// the arm by the opposite leg's hip (thigh) angle and the backward swing by its hip–ankle
+/// vector. The switch is made smooth: pure hip–ankle angle from heel strike to mid-support,
+/// blending into the thigh angle from mid-support through toe off to the next mid-support
+/// (when the leg swings), pure thigh angle until the swing leg's mid-support, and blending back
+/// into the hip–ankle angle until heel strike. `beta` is the weight of the hip–ankle angle.
 #[inline]
-pub fn arm_driver(role: LegRole, angles: &LegAngles, points: &LegPoints, flight_progress: f64) -> f64 {
+pub fn arm_driver(angles: &LegAngles, points: &LegPoints, beta: f64) -> f64 {
     let ha = points.ankle - points.hip;
     let hip_ankle = pitch_from_down(DVec2::new(ha.x, ha.y));
-    let s = smooth01(flight_progress);
-    match role {
-        LegRole::Stance => hip_ankle,
-        LegRole::Swing => angles.pitch,
-        LegRole::Hind => hip_ankle + s * (angles.pitch - hip_ankle),
-        LegRole::Front => angles.pitch + s * (hip_ankle - angles.pitch),
+    angles.pitch + beta * (hip_ankle - angles.pitch)
+}
+
+/// The hip–ankle weight of the arm driver for the stance leg (`stance = true`) or the swing
+/// leg of a step at time `t` (see [`arm_driver`]).
+#[inline]
+pub fn arm_beta(plan: &StepPlan, t: f64, stance: bool) -> f64 {
+    let span = (plan.t_step - plan.t_ms).max(1e-6);
+    let s = smooth01((t - plan.t_ms) / span);
+    if stance {
+        1.0 - s
+    } else {
+        s
     }
 }
 
@@ -115,11 +112,14 @@ pub fn fill_upper(plan: &StepPlan, t: f64, yaw: f64, roll: f64, drivers: [f64; 2
     r[Joint::Neck.index()] = w_tu.inverse() * w_neck;
     r[Joint::Head.index()] = w_neck.inverse();
     // Arms, relative to the thorax (the clavicles stay at rest).
-    let arm_back = {
+    let (arm_back, arm_front) = {
         let s = smooth01(t / plan.t_ms.max(1e-6));
-        plan.arm_back.0 + s * (plan.arm_back.1 - plan.arm_back.0)
+        (
+            plan.arm_back.0 + s * (plan.arm_back.1 - plan.arm_back.0),
+            plan.arm_front.0 + s * (plan.arm_front.1 - plan.arm_front.0),
+        )
     };
-    let front = swing * plan.eff.swing_hip;
+    let front = swing * arm_front;
     let back = swing * arm_back;
     let stop_fade = if plan.kind == StepKind::Stop { 1.0 - smooth01(t / plan.t_step) } else { 1.0 };
     for (side, sign) in [(0usize, -1.0f64), (1usize, 1.0f64)] {
