@@ -213,10 +213,24 @@ pub const SPECS: [AttrSpec; 19] = [
 impl Attr {
     /// All attributes in table order.
     pub const ALL: [Attr; 19] = [
-        Attr::ArmSwing, Attr::ElbowMin, Attr::ElbowMax, Attr::ShoulderRotation, Attr::ArmAbduction,
-        Attr::TorsoTilt, Attr::TorsoSway, Attr::PelvicRotation, Attr::PelvicList,
-        Attr::LateralDisplacement, Attr::Strike, Attr::Bounciness, Attr::Overstride,
-        Attr::StrideWidth, Attr::KneeHeelStrike, Attr::KneeToeOff, Attr::SwingKnee, Attr::SwingHip,
+        Attr::ArmSwing,
+        Attr::ElbowMin,
+        Attr::ElbowMax,
+        Attr::ShoulderRotation,
+        Attr::ArmAbduction,
+        Attr::TorsoTilt,
+        Attr::TorsoSway,
+        Attr::PelvicRotation,
+        Attr::PelvicList,
+        Attr::LateralDisplacement,
+        Attr::Strike,
+        Attr::Bounciness,
+        Attr::Overstride,
+        Attr::StrideWidth,
+        Attr::KneeHeelStrike,
+        Attr::KneeToeOff,
+        Attr::SwingKnee,
+        Attr::SwingHip,
         Attr::SwingAnkle,
     ];
 
@@ -333,9 +347,16 @@ impl RunAttributes {
         let s = body_height / 1.8;
         let mut values = [0.0; 19];
         for (v, spec) in values.iter_mut().zip(SPECS.iter()) {
-            *v = if spec.unit == AttrUnit::Metres { spec.default * s } else { spec.default };
+            *v = if spec.unit == AttrUnit::Metres {
+                spec.default * s
+            } else {
+                spec.default
+            };
         }
-        RunAttributes { body_height, values }
+        RunAttributes {
+            body_height,
+            values,
+        }
     }
 
     /// Body height the settings are for, m.
@@ -352,14 +373,29 @@ impl RunAttributes {
     /// (scaled to the body height for lengths).
     pub fn set(&mut self, a: Attr, value: f64) -> Result<(), GenerateError> {
         let spec = a.spec();
-        let s = if spec.unit == AttrUnit::Metres { self.body_height / 1.8 } else { 1.0 };
+        let s = if spec.unit == AttrUnit::Metres {
+            self.body_height / 1.8
+        } else {
+            1.0
+        };
         let (lo, hi) = (spec.min * s, spec.max * s);
-        let shown = |x: f64| if spec.unit == AttrUnit::Degrees { x.to_degrees() } else { x };
+        let shown = |x: f64| {
+            if spec.unit == AttrUnit::Degrees {
+                x.to_degrees()
+            } else {
+                x
+            }
+        };
         if !value.is_finite() || value < lo - 1e-12 || value > hi + 1e-12 {
             return Err(GenerateError::Parameter {
                 name: spec.name.into(),
                 value: shown(value),
-                message: format!("must be within [{}, {}] ({})", shown(lo), shown(hi), unit_name(spec.unit)),
+                message: format!(
+                    "must be within [{}, {}] ({})",
+                    shown(lo),
+                    shown(hi),
+                    unit_name(spec.unit)
+                ),
             });
         }
         if spec.unit == AttrUnit::Switch && value != 0.0 && value != 1.0 {
@@ -388,14 +424,22 @@ impl RunAttributes {
         };
         let eff = |a: Attr| {
             let spec = a.spec();
-            let scale = if spec.unit == AttrUnit::Metres { s } else { 1.0 };
+            let scale = if spec.unit == AttrUnit::Metres {
+                s
+            } else {
+                1.0
+            };
             let mut v = self.values[a.index()] / scale;
             for c in spec.couplings {
                 v += c.slope * (driver_n(c.driver).clamp(c.range.0, c.range.1) - c.reference);
             }
             v.clamp(spec.min, spec.max) * scale
         };
-        let strike = if self.values[Attr::Strike.index()] >= 0.5 { Strike::Toe } else { Strike::Heel };
+        let strike = if self.values[Attr::Strike.index()] >= 0.5 {
+            Strike::Toe
+        } else {
+            Strike::Heel
+        };
         let overstride = eff(Attr::Overstride);
         let sl_n = drv.step_length / s;
         Effective {
@@ -451,17 +495,36 @@ mod tests {
     #[test]
     fn couplings_act_in_the_papers_directions() {
         let a = RunAttributes::defaults(1.8);
-        let slow = Drivers { speed: 2.0, step_length: 0.8, step_freq: 2.5, flight_height: 0.002 };
-        let fast = Drivers { speed: 5.0, step_length: 1.5, step_freq: 3.3, flight_height: 0.01 };
+        let slow = Drivers {
+            speed: 2.0,
+            step_length: 0.8,
+            step_freq: 2.5,
+            flight_height: 0.002,
+        };
+        let fast = Drivers {
+            speed: 5.0,
+            step_length: 1.5,
+            step_freq: 3.3,
+            flight_height: 0.01,
+        };
         let (es, ef) = (a.effective(&slow), a.effective(&fast));
         assert!(ef.overstride < es.overstride, "overstride falls with v");
-        assert!(ef.pelvic_rotation > es.pelvic_rotation, "pelvic rotation rises with sl");
+        assert!(
+            ef.pelvic_rotation > es.pelvic_rotation,
+            "pelvic rotation rises with sl"
+        );
         assert!(ef.bounciness > es.bounciness, "bounciness rises with H");
         assert!(ef.torso_tilt > es.torso_tilt, "tilt rises with v");
-        assert!(ef.lateral_displacement < es.lateral_displacement, "lateral falls with sf");
+        assert!(
+            ef.lateral_displacement < es.lateral_displacement,
+            "lateral falls with sf"
+        );
         assert!(ef.meta_toe_off > es.meta_toe_off);
         assert!(ef.ankle_toe_off < es.ankle_toe_off);
-        assert!(ef.knee_toe_off < es.knee_toe_off, "knee (flexion) at toe off falls with sl");
+        assert!(
+            ef.knee_toe_off < es.knee_toe_off,
+            "knee (flexion) at toe off falls with sl"
+        );
     }
 
     #[test]

@@ -49,9 +49,15 @@ impl Seg3 {
     /// Position and velocity at `t`.
     #[inline]
     pub fn eval(&self, t: f64) -> (DVec3, DVec3) {
-        let (x, dx) = hermite(self.t0, self.t1, self.p0.x, self.p1.x, self.v0.x, self.v1.x, t);
-        let (y, dy) = hermite(self.t0, self.t1, self.p0.y, self.p1.y, self.v0.y, self.v1.y, t);
-        let (z, dz) = hermite(self.t0, self.t1, self.p0.z, self.p1.z, self.v0.z, self.v1.z, t);
+        let (x, dx) = hermite(
+            self.t0, self.t1, self.p0.x, self.p1.x, self.v0.x, self.v1.x, t,
+        );
+        let (y, dy) = hermite(
+            self.t0, self.t1, self.p0.y, self.p1.y, self.v0.y, self.v1.y, t,
+        );
+        let (z, dz) = hermite(
+            self.t0, self.t1, self.p0.z, self.p1.z, self.v0.z, self.v1.z, t,
+        );
         (DVec3::new(x, y, z), DVec3::new(dx, dy, dz))
     }
 }
@@ -108,8 +114,16 @@ impl KneeBump {
         if t >= self.t1 {
             return (0.0, 0.0);
         }
-        let (a, b, up) = if t <= self.peak { (self.t0, self.peak, true) } else { (self.peak, self.t1, false) };
-        let (p0, p1) = if up { (0.0, self.amount) } else { (self.amount, 0.0) };
+        let (a, b, up) = if t <= self.peak {
+            (self.t0, self.peak, true)
+        } else {
+            (self.peak, self.t1, false)
+        };
+        let (p0, p1) = if up {
+            (0.0, self.amount)
+        } else {
+            (self.amount, 0.0)
+        };
         hermite(a, b, p0, p1, 0.0, 0.0, t)
     }
 }
@@ -178,7 +192,14 @@ impl Track {
             return (LegAngles::default(), LegAngles::default());
         }
         if n == 1 || t <= self.keys[0].t {
-            return (self.keys[0].val, if n == 1 { LegAngles::default() } else { self.keys[0].rate });
+            return (
+                self.keys[0].val,
+                if n == 1 {
+                    LegAngles::default()
+                } else {
+                    self.keys[0].rate
+                },
+            );
         }
         let mut i = 0;
         while i + 2 < n && t > self.keys[i + 1].t {
@@ -188,7 +209,15 @@ impl Track {
         let mut v = LegAngles::default();
         let mut r = LegAngles::default();
         for c in 0..5 {
-            let (x, dx) = hermite(a.t, b.t, a.val.get(c), b.val.get(c), a.rate.get(c), b.rate.get(c), t);
+            let (x, dx) = hermite(
+                a.t,
+                b.t,
+                a.val.get(c),
+                b.val.get(c),
+                a.rate.get(c),
+                b.rate.get(c),
+                t,
+            );
             v.set(c, x);
             r.set(c, dx);
         }
@@ -218,12 +247,30 @@ mod tests {
 
     #[test]
     fn c2_spline_has_continuous_second_derivative() {
-        let (p0, p1, p2) = (DVec3::ZERO, DVec3::new(1.0, -0.2, 0.1), DVec3::new(2.5, 0.3, 0.0));
+        let (p0, p1, p2) = (
+            DVec3::ZERO,
+            DVec3::new(1.0, -0.2, 0.1),
+            DVec3::new(2.5, 0.3, 0.0),
+        );
         let (v0, v2) = (DVec3::new(1.0, -1.0, 0.0), DVec3::new(2.0, 1.0, -0.5));
         let h = 0.5;
         let m = c2_mid_velocity(p0, p2, v0, v2, h);
-        let a = Seg3 { t0: 0.0, t1: h, p0, p1, v0, v1: m };
-        let b = Seg3 { t0: h, t1: 2.0 * h, p0: p1, p1: p2, v0: m, v1: v2 };
+        let a = Seg3 {
+            t0: 0.0,
+            t1: h,
+            p0,
+            p1,
+            v0,
+            v1: m,
+        };
+        let b = Seg3 {
+            t0: h,
+            t1: 2.0 * h,
+            p0: p1,
+            p1: p2,
+            v0: m,
+            v1: v2,
+        };
         let e = 1e-6;
         let acc_a = (a.eval(h).1 - a.eval(h - e).1) / e;
         let acc_b = (b.eval(h + e).1 - b.eval(h).1) / e;

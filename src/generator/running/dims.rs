@@ -57,7 +57,10 @@ impl RunnerDims {
 
     /// Dimensions for a figure of `body_height` m with the table proportions.
     pub fn from_height(body_height: f64) -> Result<Self, crate::generator::GenerateError> {
-        Ok(Self::from_anthropometry(&Anthropometry::from_height(body_height, 70.0)?))
+        Ok(Self::from_anthropometry(&Anthropometry::from_height(
+            body_height,
+            70.0,
+        )?))
     }
 
     /// Heel to toe tip along the sole of a flat foot, m.
@@ -85,7 +88,11 @@ impl RunnerDims {
 
     /// The hip of `side_sign` (+1 right, −1 left) relative to the pelvis root, pelvis frame.
     pub fn hip_local(&self, side_sign: f64) -> DVec3 {
-        DVec3::new(self.hip_offset.x, self.hip_offset.y, side_sign * self.hip_offset.z)
+        DVec3::new(
+            self.hip_offset.x,
+            self.hip_offset.y,
+            side_sign * self.hip_offset.z,
+        )
     }
 
     /// Heel relative to the ankle in the foot frame (sagittal).
@@ -222,7 +229,14 @@ pub fn leg_fk(d: &RunnerDims, hip: DVec3, a: &LegAngles) -> LegPoints {
     };
     let ball = on_toe(DVec2::new(0.0, -d.mtp_height));
     let toe = on_toe(DVec2::new(d.toe, -d.mtp_height));
-    LegPoints { hip, knee, ankle, heel, ball, toe }
+    LegPoints {
+        hip,
+        knee,
+        ankle,
+        heel,
+        ball,
+        toe,
+    }
 }
 
 /// Inverse kinematics of one leg: hip and ankle positions, foot pitch and toe angle given.
@@ -230,7 +244,13 @@ pub fn leg_fk(d: &RunnerDims, hip: DVec3, a: &LegAngles) -> LegPoints {
 /// Returns the angles and whether the ankle was out of reach (then the leg is straight and
 /// points at it).
 #[inline]
-pub fn leg_ik(d: &RunnerDims, hip: DVec3, ankle: DVec3, foot_pitch: f64, meta: f64) -> (LegAngles, bool) {
+pub fn leg_ik(
+    d: &RunnerDims,
+    hip: DVec3,
+    ankle: DVec3,
+    foot_pitch: f64,
+    meta: f64,
+) -> (LegAngles, bool) {
     let v = ankle - hip;
     let roll = (-v.z).atan2(-v.y);
     let down = -(v.y * v.y + v.z * v.z).sqrt();
@@ -241,12 +261,19 @@ pub fn leg_ik(d: &RunnerDims, hip: DVec3, ankle: DVec3, foot_pitch: f64, meta: f
     let out = dist_raw > reach;
     let dist = dist_raw.clamp(lo, reach);
     let knee = d.knee_for_distance(dist);
-    let cos_alpha =
-        ((d.thigh * d.thigh + dist * dist - d.shank * d.shank) / (2.0 * d.thigh * dist)).clamp(-1.0, 1.0);
+    let cos_alpha = ((d.thigh * d.thigh + dist * dist - d.shank * d.shank)
+        / (2.0 * d.thigh * dist))
+        .clamp(-1.0, 1.0);
     let pitch = pitch_from_down(p) + cos_alpha.acos();
     let shank = pitch - knee;
     (
-        LegAngles { pitch, roll, knee, ankle: foot_pitch - shank, meta },
+        LegAngles {
+            pitch,
+            roll,
+            knee,
+            ankle: foot_pitch - shank,
+            meta,
+        },
         out,
     )
 }
@@ -288,10 +315,14 @@ mod tests {
     fn b1_lengths_at_1_8_m() {
         let d = RunnerDims::from_height(1.8).unwrap();
         assert!((d.thigh - 0.426).abs() < 1e-3); // walking paper's own example: l3 = 0.426 m
-        // l8 + l5 + l6 of table B-1.
+                                                 // l8 + l5 + l6 of table B-1.
         assert!((d.foot_length() - (0.02959 + 0.0858 + 0.04734) * 1.8).abs() < 1e-12);
         // A flat foot has heel, ball and toe on the sole.
-        let p = leg_fk(&d, DVec3::new(0.0, d.leg_reach() + d.ankle_height, 0.0), &LegAngles::default());
+        let p = leg_fk(
+            &d,
+            DVec3::new(0.0, d.leg_reach() + d.ankle_height, 0.0),
+            &LegAngles::default(),
+        );
         assert!(p.heel.y.abs() < 1e-12 && p.ball.y.abs() < 1e-12 && p.toe.y.abs() < 1e-12);
     }
 
@@ -303,7 +334,11 @@ mod tests {
         let (a, out) = leg_ik(&d, hip, ankle, 0.2, 0.1);
         assert!(!out);
         let p = leg_fk(&d, hip, &a);
-        assert!((p.ankle - ankle).length() < 1e-12, "{:?} vs {ankle:?}", p.ankle);
+        assert!(
+            (p.ankle - ankle).length() < 1e-12,
+            "{:?} vs {ankle:?}",
+            p.ankle
+        );
         assert!((a.foot_pitch() - 0.2).abs() < 1e-12);
         assert!(p.knee.x > hip.x.min(ankle.x), "knee bends forward");
     }

@@ -34,14 +34,21 @@ fn fits_err(path: &Path, e: impl std::fmt::Display) -> GenerateError {
     GenerateError::Parameter {
         name: "fits".into(),
         value: f64::NAN,
-        message: format!("{}: {e}; run `gaitfit fit` first, or drop --fits to use the published coefficients", path.display()),
+        message: format!(
+            "{}: {e}; run `gaitfit fit` first, or drop --fits to use the published coefficients",
+            path.display()
+        ),
     }
 }
 
 impl RunRelations {
     /// The published coefficients of Bruderlin & Calvert (1996).
     pub fn published() -> Self {
-        RunRelations { sl_v: RunSlV::published(), tflight: RunTflightSf::published(), source: "published".into() }
+        RunRelations {
+            sl_v: RunSlV::published(),
+            tflight: RunTflightSf::published(),
+            source: "published".into(),
+        }
     }
 
     /// Refitted coefficients from `dir/run-sl-v.json` and `dir/run-tflight-sf.json` (or, when
@@ -57,7 +64,11 @@ impl RunRelations {
             }
         }
         let tflight = RunTflightSf::from_fit_file(&tf_path).map_err(|e| fits_err(&tf_path, e))?;
-        Ok(RunRelations { sl_v, tflight, source: dir.display().to_string() })
+        Ok(RunRelations {
+            sl_v,
+            tflight,
+            source: dir.display().to_string(),
+        })
     }
 
     /// The speed (m/s) above which step length stays constant: v_norm·√(h/1.8).
@@ -68,7 +79,8 @@ impl RunRelations {
     /// Eq. 2: step length (m) at speed `v` (m/s), normalised level, body height (m); constant
     /// above v_norm.
     pub fn step_length(&self, v: f64, level: f64, body_height: f64) -> f64 {
-        self.sl_v.step_length(m_per_s_to_m_per_min(v), body_height, level * LEVEL_SCALE_SL)
+        self.sl_v
+            .step_length(m_per_s_to_m_per_min(v), body_height, level * LEVEL_SCALE_SL)
     }
 
     /// The constant step length above v_norm, m.
@@ -87,7 +99,9 @@ impl RunRelations {
     /// Eqs. 1 and 2 together: the natural step length (m) at step frequency `sf` (steps/s).
     pub fn step_length_for_freq(&self, sf: f64, level: f64, body_height: f64) -> Option<f64> {
         let f = hz_to_steps_per_min(sf);
-        let v = self.sl_v.speed_for_step_freq(f, body_height, level * LEVEL_SCALE_SL)?;
+        let v = self
+            .sl_v
+            .speed_for_step_freq(f, body_height, level * LEVEL_SCALE_SL)?;
         (v > 0.0).then(|| v / f)
     }
 

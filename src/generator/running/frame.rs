@@ -4,7 +4,9 @@
 use glam::{DQuat, DVec3};
 
 use super::curves::hermite;
-use super::dims::{leg_fk, leg_ik, leg_orientations, pelvis_orientation, LegAngles, LegPoints, RunnerDims};
+use super::dims::{
+    leg_fk, leg_ik, leg_orientations, pelvis_orientation, LegAngles, LegPoints, RunnerDims,
+};
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
 use super::state::{StepKind, StepPlan};
 use super::upper_body::{arm_beta, arm_driver, fill_upper};
@@ -48,7 +50,11 @@ fn stop_swing(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> (LegAngles
         let (a, _) = leg_ik(d, hip, sp.print.flat_ankle(d), 0.0, 0.0);
         return (a, leg_fk(d, hip, &a), true);
     }
-    let seg = if t < sp.ankle[0].t1 { &sp.ankle[0] } else { &sp.ankle[1] };
+    let seg = if t < sp.ankle[0].t1 {
+        &sp.ankle[0]
+    } else {
+        &sp.ankle[1]
+    };
     let (ankle, _) = seg.eval(t);
     let s = smooth01(t / (0.8 * sp.t_land));
     let pitch = sp.pitch0 * (1.0 - s);
@@ -84,7 +90,11 @@ pub fn eval_frame(plan: &StepPlan, d: &RunnerDims, t: f64, pose: &mut Pose) -> F
         (a, leg_fk(d, hip_sw, &a), t <= 0.0)
     } else {
         let (a, _) = plan.swing.eval(t);
-        (a, leg_fk(d, hip_sw, &a), plan.kind == StepKind::Start && t <= 0.0)
+        (
+            a,
+            leg_fk(d, hip_sw, &a),
+            plan.kind == StepKind::Start && t <= 0.0,
+        )
     };
 
     pose.root = pelvis;

@@ -136,7 +136,11 @@ pub fn generate_run(
             stopped_at = Some(i);
         }
         // Extend past `seconds` only to finish a stop that ran late, plus a short hold.
-        if past_end && (stopped_at.is_some_and(|s| i >= s + (0.2 * opts.fps) as usize) || !(opts.stop_at_end || scheduled_stop) || i > n + (60.0 * opts.fps) as usize) {
+        if past_end
+            && (stopped_at.is_some_and(|s| i >= s + (0.2 * opts.fps) as usize)
+                || !(opts.stop_at_end || scheduled_stop)
+                || i > n + (60.0 * opts.fps) as usize)
+        {
             break;
         }
         if let Some(ts) = stop_at {
@@ -149,21 +153,48 @@ pub fn generate_run(
         i += 1;
     }
     let end = motion.duration_s();
-    motion.events = runner.events().iter().copied().filter(|e| e.time_s <= end + 1e-9).collect();
-    let steps: Vec<StepRecord> = runner.steps().iter().copied().filter(|s| s.start_s <= end).collect();
+    motion.events = runner
+        .events()
+        .iter()
+        .copied()
+        .filter(|e| e.time_s <= end + 1e-9)
+        .collect();
+    let steps: Vec<StepRecord> = runner
+        .steps()
+        .iter()
+        .copied()
+        .filter(|s| s.start_s <= end)
+        .collect();
     let mut notes = Vec::new();
     for s in &steps {
         let r = &s.report;
         if r.mid_support_lowered > 0 {
-            notes.push(format!("step {}: hip too high, mid-support control point lowered {} time(s)", s.index, r.mid_support_lowered));
+            notes.push(format!(
+                "step {}: hip too high, mid-support control point lowered {} time(s)",
+                s.index, r.mid_support_lowered
+            ));
         }
         if r.clearance_keys > 0 {
-            notes.push(format!("step {}: foot stubbing, {} control point(s) with more knee flexion inserted", s.index, r.clearance_keys));
+            notes.push(format!(
+                "step {}: foot stubbing, {} control point(s) with more knee flexion inserted",
+                s.index, r.clearance_keys
+            ));
         }
         if r.out_of_reach {
-            notes.push(format!("step {}: the stance hip is out of reach somewhere; the foot may lift", s.index));
+            notes.push(format!(
+                "step {}: the stance hip is out of reach somewhere; the foot may lift",
+                s.index
+            ));
         }
     }
     motion.metadata.notes.extend(notes.iter().cloned());
-    Ok((motion, RunReport { steps, relations: model.relations.source.clone(), initial: params, notes }))
+    Ok((
+        motion,
+        RunReport {
+            steps,
+            relations: model.relations.source.clone(),
+            initial: params,
+            notes,
+        },
+    ))
 }

@@ -24,9 +24,9 @@ use argmin::solver::brent::BrentRoot;
 
 use super::attributes::{Drivers, RunAttributes};
 use super::dims::RunnerDims;
-use crate::generator::skeleton::Skeleton;
 use super::equations::RunRelations;
 use super::state::{state_keyframes, FlightSpec, Footprint, StepInput};
+use crate::generator::skeleton::Skeleton;
 use crate::generator::GenerateError;
 use crate::units::{hz_to_steps_per_min, steps_per_min_to_hz};
 
@@ -152,9 +152,14 @@ pub struct RunModel {
 }
 
 fn param_err(name: &str, value: f64, message: String) -> GenerateError {
-    GenerateError::Parameter { name: name.into(), value, message }
+    GenerateError::Parameter {
+        name: name.into(),
+        value,
+        message,
+    }
 }
 
+#[derive(Clone, Copy)]
 struct HRoot<'a> {
     model: &'a RunModel,
     attrs: &'a RunAttributes,
@@ -180,7 +185,10 @@ impl HRoot<'_> {
             Along::Speed(v) => Some((v, v / sf, sf)),
             Along::StepLength(sl) => Some((sl * sf, sl, sf)),
             Along::Natural => {
-                let sl = self.model.relations.step_length_for_freq(sf, self.level, h)?;
+                let sl = self
+                    .model
+                    .relations
+                    .step_length_for_freq(sf, self.level, h)?;
                 Some((sl * sf, sl, sf))
             }
         }
@@ -188,7 +196,10 @@ impl HRoot<'_> {
     fn h_at(&self, sf: f64) -> Option<f64> {
         let (v, sl, sf) = self.triple(sf)?;
         let t_f = self.model.relations.flight_time(sf, self.level);
-        self.model.steady_flight(v, sl, sf, FlightSpec::Time(t_f), self.attrs).ok().map(|(h, _)| h)
+        self.model
+            .steady_flight(v, sl, sf, FlightSpec::Time(t_f), self.attrs)
+            .ok()
+            .map(|(h, _)| h)
     }
 }
 
@@ -207,7 +218,11 @@ impl RunModel {
     pub fn new(skeleton: Skeleton, relations: RunRelations) -> Result<Self, GenerateError> {
         check_height(skeleton.anthropometry().height_m)?;
         let dims = RunnerDims::from_anthropometry(skeleton.anthropometry());
-        Ok(RunModel { skeleton, dims, relations })
+        Ok(RunModel {
+            skeleton,
+            dims,
+            relations,
+        })
     }
 
     /// A model with the published relations for a figure of `body_height` m with table B-1
@@ -233,17 +248,46 @@ impl RunModel {
             FlightSpec::Time(_) => super::attributes::H_REF * self.dims.body_height / 1.8,
         };
         // Bounciness (the only H-coupled attribute) does not enter eq. 3, so any H will do here.
-        let eff = attrs.effective(&Drivers { speed: v, step_length: sl, step_freq: sf, flight_height: h_guess });
-        let inp = StepInput { speed: v, step_length: sl, step_freq: sf, flight, eff, next_eff: eff, p: 0.75 };
-        let fp = Footprint { heel: glam::DVec3::new(0.0, 0.0, eff.stride_width / 2.0), strike: eff.strike, impact_pitch: eff.impact_pitch };
+        let eff = attrs.effective(&Drivers {
+            speed: v,
+            step_length: sl,
+            step_freq: sf,
+            flight_height: h_guess,
+        });
+        let inp = StepInput {
+            speed: v,
+            step_length: sl,
+            step_freq: sf,
+            flight,
+            eff,
+            next_eff: eff,
+            p: 0.75,
+        };
+        let fp = Footprint {
+            heel: glam::DVec3::new(0.0, 0.0, eff.stride_width / 2.0),
+            strike: eff.strike,
+            impact_pitch: eff.impact_pitch,
+        };
         let k = state_keyframes(&self.dims, &inp, 1.0, &fp)?;
         Ok((k.flight_height, k.t_flight))
     }
 
-    fn finish(&self, v: f64, sl: f64, sf: f64, base: &RunParams, from_h: Option<f64>, attrs: &RunAttributes) -> Result<RunParams, GenerateError> {
+    fn finish(
+        &self,
+        v: f64,
+        sl: f64,
+        sf: f64,
+        base: &RunParams,
+        from_h: Option<f64>,
+        attrs: &RunAttributes,
+    ) -> Result<RunParams, GenerateError> {
         check_speed(v)?;
         if !(sl > 0.0 && sf > 0.0 && sl.is_finite() && sf.is_finite()) {
-            return Err(param_err("step_length", sl, format!("no positive step length/frequency (sl = {sl}, sf = {sf})")));
+            return Err(param_err(
+                "step_length",
+                sl,
+                format!("no positive step length/frequency (sl = {sl}, sf = {sf})"),
+            ));
         }
         let (h, t_f, flight_from_height) = match from_h {
             Some(h) => {
@@ -269,7 +313,12 @@ impl RunModel {
 
     /// The natural parameters at speed `v` (m/s): sl by eq. 2, sf by eq. 1, t_flight by eqs. 4–5,
     /// H by eq. 3.
-    pub fn natural(&self, v: f64, level: f64, attrs: &RunAttributes) -> Result<RunParams, GenerateError> {
+    pub fn natural(
+        &self,
+        v: f64,
+        level: f64,
+        attrs: &RunAttributes,
+    ) -> Result<RunParams, GenerateError> {
         check_level(level)?;
         check_speed(v)?;
         let h = self.dims.body_height;
@@ -290,7 +339,13 @@ impl RunModel {
 
     /// Changes parameter `which` to `value` and updates the others by the rule in the module
     /// docs, keeping locked parameters.
-    pub fn set(&self, cur: &RunParams, which: Param, value: f64, attrs: &RunAttributes) -> Result<RunParams, GenerateError> {
+    pub fn set(
+        &self,
+        cur: &RunParams,
+        which: Param,
+        value: f64,
+        attrs: &RunAttributes,
+    ) -> Result<RunParams, GenerateError> {
         let name = match which {
             Param::Speed => "speed",
             Param::StepLength => "step_length",
@@ -301,7 +356,12 @@ impl RunModel {
             return Err(param_err(name, value, "must be a positive number".into()));
         }
         let fixed = |p: Param| p == which || cur.locks.get(p);
-        let (fv, fsl, fsf, fh) = (fixed(Param::Speed), fixed(Param::StepLength), fixed(Param::StepFreq), fixed(Param::FlightHeight));
+        let (fv, fsl, fsf, fh) = (
+            fixed(Param::Speed),
+            fixed(Param::StepLength),
+            fixed(Param::StepFreq),
+            fixed(Param::FlightHeight),
+        );
         let val = |p: Param| if p == which { value } else { cur.get(p) };
         let n = [fv, fsl, fsf].iter().filter(|b| **b).count();
         let lvl = cur.level;
@@ -322,17 +382,31 @@ impl RunModel {
             }
             2 => {
                 let (v, sl, sf) = if !fv {
-                    (val(Param::StepLength) * val(Param::StepFreq), val(Param::StepLength), val(Param::StepFreq))
+                    (
+                        val(Param::StepLength) * val(Param::StepFreq),
+                        val(Param::StepLength),
+                        val(Param::StepFreq),
+                    )
                 } else if !fsl {
-                    (val(Param::Speed), val(Param::Speed) / val(Param::StepFreq), val(Param::StepFreq))
+                    (
+                        val(Param::Speed),
+                        val(Param::Speed) / val(Param::StepFreq),
+                        val(Param::StepFreq),
+                    )
                 } else {
-                    (val(Param::Speed), val(Param::StepLength), val(Param::Speed) / val(Param::StepLength))
+                    (
+                        val(Param::Speed),
+                        val(Param::StepLength),
+                        val(Param::Speed) / val(Param::StepLength),
+                    )
                 };
                 self.finish(v, sl, sf, cur, target_h, attrs)
             }
             1 if fsf && target_h.is_some() => {
                 let sf = val(Param::StepFreq);
-                let sl = rel.step_length_for_freq(sf, lvl, h).ok_or_else(|| no_natural(sf))?;
+                let sl = rel
+                    .step_length_for_freq(sf, lvl, h)
+                    .ok_or_else(|| no_natural(sf))?;
                 self.finish(sl * sf, sl, sf, cur, target_h, attrs)
             }
             1 if target_h.is_none() => {
@@ -347,11 +421,15 @@ impl RunModel {
                         Some(v) => self.finish(v, sl, v / sl, cur, None, attrs),
                         // Beyond the rising part of eq. 2 (sl above sl_norm or below a): keep
                         // the step frequency, and v follows by eq. 1.
-                        None => self.finish(sl * cur.step_freq, sl, cur.step_freq, cur, None, attrs),
+                        None => {
+                            self.finish(sl * cur.step_freq, sl, cur.step_freq, cur, None, attrs)
+                        }
                     }
                 } else {
                     let sf = val(Param::StepFreq);
-                    let sl = rel.step_length_for_freq(sf, lvl, h).ok_or_else(|| no_natural(sf))?;
+                    let sl = rel
+                        .step_length_for_freq(sf, lvl, h)
+                        .ok_or_else(|| no_natural(sf))?;
                     self.finish(sl * sf, sl, sf, cur, None, attrs)
                 }
             }
@@ -365,7 +443,13 @@ impl RunModel {
                 } else {
                     Along::Natural
                 };
-                let root = HRoot { model: self, attrs, level: lvl, target, along };
+                let root = HRoot {
+                    model: self,
+                    attrs,
+                    level: lvl,
+                    target,
+                    along,
+                };
                 let sf = solve_sf(&root, cur.step_freq)?;
                 let (v, sl, sf) = root.triple(sf).ok_or_else(|| no_natural(sf))?;
                 self.finish(v, sl, sf, cur, None, attrs)
@@ -387,7 +471,10 @@ fn no_natural(sf: f64) -> GenerateError {
 /// across the jump of eqs. 4–5 at the knot is not a root and is rejected.
 fn solve_sf(root: &HRoot<'_>, current: f64) -> Result<f64, GenerateError> {
     let n = 400;
-    let (lo, hi) = (steps_per_min_to_hz(SF_SEARCH.0), steps_per_min_to_hz(SF_SEARCH.1));
+    let (lo, hi) = (
+        steps_per_min_to_hz(SF_SEARCH.0),
+        steps_per_min_to_hz(SF_SEARCH.1),
+    );
     let mut prev: Option<(f64, f64)> = None;
     let mut best: Option<(f64, f64, f64)> = None; // (distance, a, b)
     let (mut hmin, mut hmax) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -418,7 +505,9 @@ fn solve_sf(root: &HRoot<'_>, current: f64) -> Result<f64, GenerateError> {
         param_err(
             "flight_height",
             root.target,
-            format!("not reachable here: steady flight heights range over [{hmin:.4}, {hmax:.4}] m"),
+            format!(
+                "not reachable here: steady flight heights range over [{hmin:.4}, {hmax:.4}] m"
+            ),
         )
     };
     let (_, a, b) = best.ok_or_else(no)?;
@@ -428,25 +517,31 @@ fn solve_sf(root: &HRoot<'_>, current: f64) -> Result<f64, GenerateError> {
     let res = Executor::new(problem, solver)
         .configure(|s| s.max_iters(200))
         .run()
-        .map_err(|e| param_err("flight_height", target, format!("root search for sf failed: {e}")))?;
+        .map_err(|e| {
+            param_err(
+                "flight_height",
+                target,
+                format!("root search for sf failed: {e}"),
+            )
+        })?;
     let sf = res.state.best_param.ok_or_else(no)?;
-    let resid = root.h_at(sf).map(|h| (h - target).abs()).unwrap_or(f64::INFINITY);
+    let resid = root
+        .h_at(sf)
+        .map(|h| (h - target).abs())
+        .unwrap_or(f64::INFINITY);
     if resid > 1e-7 {
         return Err(param_err(
             "flight_height",
             target,
-            format!("falls in the jump of eqs. 4–5 at the knot (closest {:.4} m at {:.1} steps/min)", root.h_at(sf).unwrap_or(f64::NAN), hz_to_steps_per_min(sf)),
+            format!(
+                "falls in the jump of eqs. 4–5 at the knot (closest {:.4} m at {:.1} steps/min)",
+                root.h_at(sf).unwrap_or(f64::NAN),
+                hz_to_steps_per_min(sf)
+            ),
         ));
     }
     Ok(sf)
 }
-
-impl Clone for HRoot<'_> {
-    fn clone(&self) -> Self {
-        HRoot { ..*self }
-    }
-}
-impl Copy for HRoot<'_> {}
 
 /// Body mass used when none is given, kg (BMI 22.5; running kinematics do not depend on it).
 pub fn default_mass(body_height: f64) -> f64 {
@@ -458,7 +553,13 @@ fn check_speed(v: f64) -> Result<(), GenerateError> {
         return Err(param_err(
             "speed",
             v,
-            format!("m/s must be within [{}, {}] m/s ({:.1}–{:.1} km/h)", SPEED_RANGE.0, SPEED_RANGE.1, SPEED_RANGE.0 * 3.6, SPEED_RANGE.1 * 3.6),
+            format!(
+                "m/s must be within [{}, {}] m/s ({:.1}–{:.1} km/h)",
+                SPEED_RANGE.0,
+                SPEED_RANGE.1,
+                SPEED_RANGE.0 * 3.6,
+                SPEED_RANGE.1 * 3.6
+            ),
         ));
     }
     Ok(())
@@ -466,14 +567,25 @@ fn check_speed(v: f64) -> Result<(), GenerateError> {
 
 fn check_height(h: f64) -> Result<(), GenerateError> {
     if !(h >= HEIGHT_RANGE.0 && h <= HEIGHT_RANGE.1) {
-        return Err(param_err("body_height", h, format!("m must be within [{}, {}] m", HEIGHT_RANGE.0, HEIGHT_RANGE.1)));
+        return Err(param_err(
+            "body_height",
+            h,
+            format!(
+                "m must be within [{}, {}] m",
+                HEIGHT_RANGE.0, HEIGHT_RANGE.1
+            ),
+        ));
     }
     Ok(())
 }
 
 fn check_level(level: f64) -> Result<(), GenerateError> {
     if !(-1.0..=1.0).contains(&level) {
-        return Err(param_err("level", level, "must be within [−1 (poor), 1 (skilled)]".into()));
+        return Err(param_err(
+            "level",
+            level,
+            "must be within [−1 (poor), 1 (skilled)]".into(),
+        ));
     }
     Ok(())
 }

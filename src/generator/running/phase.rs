@@ -44,7 +44,11 @@ pub struct StanceEval {
 #[inline]
 pub fn pelvis_at(plan: &StepPlan, t: f64) -> (DVec3, DVec3) {
     if t <= plan.t_stance || plan.kind == StepKind::Stop {
-        let seg = if plan.nseg == 2 && t > plan.support[0].t1 { &plan.support[1] } else { &plan.support[0] };
+        let seg = if plan.nseg == 2 && t > plan.support[0].t1 {
+            &plan.support[1]
+        } else {
+            &plan.support[0]
+        };
         return seg.eval(t);
     }
     // §3.2: ballistic flight, x = x1 + v t, y = y1 + w t − g t²/2, z linear.
@@ -65,7 +69,11 @@ pub fn orient_at(plan: &StepPlan, t: f64) -> (f64, f64) {
     for i in 0..n - 1 {
         let (a, b) = (k[i], k[i + 1]);
         if t <= b.0 || i + 2 == n {
-            let s = if b.0 > a.0 { ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 1.0 };
+            let s = if b.0 > a.0 {
+                ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
             return (a.1 + s * (b.1 - a.1), a.2 + s * (b.2 - a.2));
         }
     }
@@ -127,20 +135,35 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
     let finish = |ankle: DVec3, pitch: f64, meta: f64, mode: StanceMode| {
         let (angles, out) = leg_ik(d, hip, ankle, pitch, meta);
         let points = leg_fk(d, hip, &angles);
-        StanceEval { angles, points, mode, out_of_reach: out }
+        StanceEval {
+            angles,
+            points,
+            mode,
+            out_of_reach: out,
+        }
     };
     if t < plan.t_flat {
         let pitch = pivot_pitch(plan, t);
         return match fp.strike {
             Strike::Heel => {
                 let a = rot2(pitch, DVec2::new(d.heel_back, d.ankle_height));
-                finish(fp.heel + DVec3::new(a.x, a.y, 0.0), pitch, 0.0, StanceMode::HeelPivot)
+                finish(
+                    fp.heel + DVec3::new(a.x, a.y, 0.0),
+                    pitch,
+                    0.0,
+                    StanceMode::HeelPivot,
+                )
             }
             Strike::Toe => {
                 // Toes flat: the foot rolls about the metatarsal joint, the ball stays put.
                 let mtp = fp.heel + DVec3::new(d.heel_back + d.ankle_to_ball, d.mtp_height, 0.0);
                 let a = rot2(pitch, d.mtp_f());
-                finish(mtp - DVec3::new(a.x, a.y, 0.0), pitch, -pitch, StanceMode::BallPivot)
+                finish(
+                    mtp - DVec3::new(a.x, a.y, 0.0),
+                    pitch,
+                    -pitch,
+                    StanceMode::BallPivot,
+                )
             }
         };
     }
@@ -172,7 +195,12 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
     let pitch = -m;
     let mtp = DVec2::new(toe.x - d.toe, d.mtp_height);
     let a = mtp - rot2(pitch, d.mtp_f());
-    finish(DVec3::new(a.x, a.y, z), pitch, m, StanceMode::HeelOffKneeRaised)
+    finish(
+        DVec3::new(a.x, a.y, z),
+        pitch,
+        m,
+        StanceMode::HeelOffKneeRaised,
+    )
 }
 
 #[cfg(test)]

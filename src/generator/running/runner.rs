@@ -8,7 +8,10 @@ use super::attributes::RunAttributes;
 use super::frame::{eval_frame, FrameInfo};
 use super::params::{RunModel, RunParams};
 use super::schedule::Schedule;
-use super::state::{carry_out, plan_step, plan_stop, standing_carry, state_keyframes, Carry, StepInput, StepKind, StepPlan, StepReport};
+use super::state::{
+    carry_out, plan_step, plan_stop, standing_carry, state_keyframes, Carry, StepInput, StepKind,
+    StepPlan, StepReport,
+};
 use crate::events::{EventKind, EventSource, GaitEvent, Side};
 use crate::generator::skeleton::Pose;
 use crate::generator::GenerateError;
@@ -92,7 +95,12 @@ impl Runner {
     /// A runner standing with its feet side by side at the origin, about to start with the
     /// right leg as the first stance leg, with the given parameters and attributes (and an
     /// optional per-step schedule whose step-0 rows apply to the first step).
-    pub fn new(model: RunModel, params: RunParams, attrs: RunAttributes, schedule: Option<Schedule>) -> Result<Runner, GenerateError> {
+    pub fn new(
+        model: RunModel,
+        params: RunParams,
+        attrs: RunAttributes,
+        schedule: Option<Schedule>,
+    ) -> Result<Runner, GenerateError> {
         let eff = attrs.effective(&params.drivers());
         let carry = standing_carry(&model.dims, &eff, 0.0, 1.0, f64::INFINITY);
         // Replaced by the first step's plan below, once the schedule's step-0 rows are applied.
@@ -157,7 +165,11 @@ impl Runner {
 
     /// New parameters, effective from the next step.
     pub fn set_params(&mut self, params: RunParams) {
-        let attrs = self.pending.as_ref().map(|p| p.1.clone()).unwrap_or_else(|| self.attrs.clone());
+        let attrs = self
+            .pending
+            .as_ref()
+            .map(|p| p.1.clone())
+            .unwrap_or_else(|| self.attrs.clone());
         self.pending = Some((params, attrs));
     }
 
@@ -178,18 +190,26 @@ impl Runner {
     }
 
     fn apply_schedule(&mut self) -> Result<(), GenerateError> {
-        let Some(schedule) = self.schedule.take() else { return Ok(()) };
+        let Some(schedule) = self.schedule.take() else {
+            return Ok(());
+        };
         let mut result = Ok(());
         for row in schedule.rows_at(self.step) {
             let base = self.pending.as_ref().map(|p| p.0).unwrap_or(self.params);
-            let attrs = self.pending.as_ref().map(|p| p.1.clone()).unwrap_or_else(|| self.attrs.clone());
+            let attrs = self
+                .pending
+                .as_ref()
+                .map(|p| p.1.clone())
+                .unwrap_or_else(|| self.attrs.clone());
             let mut p = base;
             let locks = p.locks;
             let mut apply = || -> Result<RunParams, GenerateError> {
                 if let Some(l) = row.level {
                     p.level = l;
                     if row.set.is_empty() {
-                        p = self.model.set(&p, super::params::Param::Speed, p.speed, &attrs)?;
+                        p = self
+                            .model
+                            .set(&p, super::params::Param::Speed, p.speed, &attrs)?;
                     }
                 }
                 for &(param, value) in &row.set {
@@ -202,7 +222,10 @@ impl Runner {
             match apply() {
                 Ok(p) => self.pending = Some((p, attrs)),
                 Err(e) => {
-                    result = Err(GenerateError::Input { path: schedule.source.clone(), message: format!("line {}: {e}", row.line) });
+                    result = Err(GenerateError::Input {
+                        path: schedule.source.clone(),
+                        message: format!("line {}: {e}", row.line),
+                    });
                     break;
                 }
             }
@@ -248,13 +271,18 @@ impl Runner {
                 if row.stop {
                     return (self.params.speed - STOP_DECELERATION * self.froude()).max(0.0);
                 }
-                if let Some(&(_, v)) = row.set.iter().find(|(p, _)| *p == super::params::Param::Speed) {
+                if let Some(&(_, v)) = row
+                    .set
+                    .iter()
+                    .find(|(p, _)| *p == super::params::Param::Speed)
+                {
                     return v;
                 }
             }
         }
         if self.stop_requested {
-            return (self.params.speed - STOP_DECELERATION * self.froude()).max(STOP_SPEED * self.froude());
+            return (self.params.speed - STOP_DECELERATION * self.froude())
+                .max(STOP_SPEED * self.froude());
         }
         self.params.speed
     }
@@ -300,7 +328,10 @@ impl Runner {
             p,
         };
         self.plan = plan_step(&d, &inp, &self.carry, kind).map_err(|e| match e {
-            GenerateError::Numerical { stage, message } => GenerateError::Numerical { stage: format!("step {}, {stage}", self.step), message },
+            GenerateError::Numerical { stage, message } => GenerateError::Numerical {
+                stage: format!("step {}, {stage}", self.step),
+                message,
+            },
             other => other,
         })?;
         self.record();
@@ -312,25 +343,34 @@ impl Runner {
         let side = side_of(pl.s);
         let other = side.opposite();
         let t0 = self.t0;
-        let ev = |t: f64, side: Side, kind: EventKind| GaitEvent { time_s: t0 + t, side, kind, source: EventSource::Generated };
+        let ev = |t: f64, side: Side, kind: EventKind| GaitEvent {
+            time_s: t0 + t,
+            side,
+            kind,
+            source: EventSource::Generated,
+        };
         match pl.kind {
             StepKind::Start => {
                 self.events.push(ev(0.0, side, EventKind::FootFlat));
                 self.events.push(ev(0.0, other, EventKind::ToeOff));
-                self.events.push(ev(pl.t_heel_off, side, EventKind::HeelOff));
+                self.events
+                    .push(ev(pl.t_heel_off, side, EventKind::HeelOff));
                 self.events.push(ev(pl.t_stance, side, EventKind::ToeOff));
             }
             StepKind::Normal => {
                 self.events.push(ev(0.0, side, EventKind::HeelStrike));
                 self.events.push(ev(pl.t_flat, side, EventKind::FootFlat));
-                self.events.push(ev(pl.t_heel_off, side, EventKind::HeelOff));
+                self.events
+                    .push(ev(pl.t_heel_off, side, EventKind::HeelOff));
                 self.events.push(ev(pl.t_stance, side, EventKind::ToeOff));
             }
             StepKind::Stop => {
                 self.events.push(ev(0.0, side, EventKind::HeelStrike));
                 self.events.push(ev(pl.t_flat, side, EventKind::FootFlat));
-                self.events.push(ev(pl.stop.t_land, other, EventKind::HeelStrike));
-                self.events.push(ev(pl.stop.t_land, other, EventKind::FootFlat));
+                self.events
+                    .push(ev(pl.stop.t_land, other, EventKind::HeelStrike));
+                self.events
+                    .push(ev(pl.stop.t_land, other, EventKind::FootFlat));
             }
         }
         self.records.push(StepRecord {
@@ -369,7 +409,11 @@ impl Runner {
     /// frame's contacts and foot points.
     pub fn pose_at(&mut self, t: f64, pose: &mut Pose) -> Result<FrameInfo, GenerateError> {
         self.advance_to(t)?;
-        let rel = if self.state == RunState::Stopped { self.plan.t_step } else { (t - self.t0).max(0.0) };
+        let rel = if self.state == RunState::Stopped {
+            self.plan.t_step
+        } else {
+            (t - self.t0).max(0.0)
+        };
         Ok(eval_frame(&self.plan, &self.model.dims, rel, pose))
     }
 

@@ -48,20 +48,29 @@ pub struct Schedule {
 }
 
 fn input_err(path: &str, message: String) -> GenerateError {
-    GenerateError::Input { path: path.into(), message }
+    GenerateError::Input {
+        path: path.into(),
+        message,
+    }
 }
 
 impl Schedule {
     /// Reads a schedule CSV file.
     pub fn from_csv(path: &Path) -> Result<Schedule, GenerateError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| input_err(&path.display().to_string(), format!("cannot read the schedule: {e}")))?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            input_err(
+                &path.display().to_string(),
+                format!("cannot read the schedule: {e}"),
+            )
+        })?;
         Schedule::parse(&text, &path.display().to_string())
     }
 
     /// Parses schedule CSV text (`source` names it in messages).
     pub fn parse(text: &str, source: &str) -> Result<Schedule, GenerateError> {
-        let mut rdr = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
+        let mut rdr = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
         let headers = rdr
             .headers()
             .map_err(|e| input_err(source, format!("line 1: cannot read the header: {e}")))?
@@ -111,7 +120,13 @@ impl Schedule {
         for (i, rec) in rdr.records().enumerate() {
             let line = i + 2;
             let rec = rec.map_err(|e| input_err(source, format!("line {line}: {e}")))?;
-            let mut row = ScheduleRow { step: i, set: Vec::new(), level: None, stop: false, line };
+            let mut row = ScheduleRow {
+                step: i,
+                set: Vec::new(),
+                level: None,
+                stop: false,
+                line,
+            };
             for (cell, (col, name)) in rec.iter().zip(cols.iter().zip(headers.iter())) {
                 if cell.is_empty() {
                     continue;
@@ -120,7 +135,12 @@ impl Schedule {
                     cell.parse::<f64>()
                         .ok()
                         .filter(|v| v.is_finite())
-                        .ok_or_else(|| input_err(source, format!("line {line}, column `{name}`: {cell:?} is not a number")))
+                        .ok_or_else(|| {
+                            input_err(
+                                source,
+                                format!("line {line}, column `{name}`: {cell:?} is not a number"),
+                            )
+                        })
                 };
                 match *col {
                     Col::Step => {
@@ -161,7 +181,10 @@ impl Schedule {
             }
             rows.push(row);
         }
-        Ok(Schedule { rows, source: source.into() })
+        Ok(Schedule {
+            rows,
+            source: source.into(),
+        })
     }
 
     /// The rows that take effect at `step`.
@@ -183,11 +206,21 @@ pub fn parse_value(text: &str, dim: Dimension) -> Result<f64, String> {
     let t: String = text.trim().chars().filter(|c| !c.is_whitespace()).collect();
     let split = t
         .char_indices()
-        .find(|(i, c)| !(c.is_ascii_digit() || *c == '.' || *c == '-' || *c == '+' || ((*c == 'e' || *c == 'E') && *i > 0 && t[i + 1..].starts_with(|d: char| d.is_ascii_digit() || d == '-'))))
+        .find(|(i, c)| {
+            !(c.is_ascii_digit()
+                || *c == '.'
+                || *c == '-'
+                || *c == '+'
+                || ((*c == 'e' || *c == 'E')
+                    && *i > 0
+                    && t[i + 1..].starts_with(|d: char| d.is_ascii_digit() || d == '-')))
+        })
         .map(|(i, _)| i)
         .unwrap_or(t.len());
     let (num, unit) = t.split_at(split);
-    let v: f64 = num.parse().map_err(|_| format!("{text:?}: no number at the start"))?;
+    let v: f64 = num
+        .parse()
+        .map_err(|_| format!("{text:?}: no number at the start"))?;
     if !v.is_finite() {
         return Err(format!("{text:?}: not a finite number"));
     }
@@ -199,7 +232,9 @@ pub fn parse_value(text: &str, dim: Dimension) -> Result<f64, String> {
         (Dimension::Length, "" | "m") => 1.0,
         (Dimension::Length, "cm") => 0.01,
         (Dimension::Length, "mm") => 0.001,
-        (Dimension::Frequency, "" | "/min" | "spm" | "steps/min" | "steps_per_min") => Unit::StepsPerMin.to_si_factor(),
+        (Dimension::Frequency, "" | "/min" | "spm" | "steps/min" | "steps_per_min") => {
+            Unit::StepsPerMin.to_si_factor()
+        }
         (Dimension::Frequency, "hz" | "/s" | "steps/s") => 1.0,
         (Dimension::Angle, "" | "deg" | "°") => std::f64::consts::PI / 180.0,
         (Dimension::Angle, "rad") => 1.0,
@@ -229,7 +264,9 @@ mod tests {
         assert!((parse_value("12km/h", Dimension::Speed).unwrap() - 12.0 / 3.6).abs() < 1e-12);
         assert!((parse_value("3.3m/s", Dimension::Speed).unwrap() - 3.3).abs() < 1e-12);
         assert!((parse_value("200m/min", Dimension::Speed).unwrap() - 200.0 / 60.0).abs() < 1e-12);
-        assert!((parse_value("187/min", Dimension::Frequency).unwrap() - 187.0 / 60.0).abs() < 1e-12);
+        assert!(
+            (parse_value("187/min", Dimension::Frequency).unwrap() - 187.0 / 60.0).abs() < 1e-12
+        );
         assert!((parse_value("3.1Hz", Dimension::Frequency).unwrap() - 3.1).abs() < 1e-12);
         assert!((parse_value("4mm", Dimension::Length).unwrap() - 0.004).abs() < 1e-12);
         assert!((parse_value("1e-3m", Dimension::Length).unwrap() - 0.001).abs() < 1e-15);
@@ -244,11 +281,17 @@ mod tests {
         assert_eq!(s.rows[1].step, 1);
         assert_eq!(s.rows[1].set, vec![(Param::Speed, 12.0 / 3.6)]);
         assert!(s.rows[2].stop && s.stops());
-        let e = Schedule::parse("speed_furlongs\n1\n", "t.csv").unwrap_err().to_string();
+        let e = Schedule::parse("speed_furlongs\n1\n", "t.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("t.csv") && e.contains("speed_furlongs"), "{e}");
-        let e = Schedule::parse("speed_km_per_h\nabc\n", "t.csv").unwrap_err().to_string();
+        let e = Schedule::parse("speed_km_per_h\nabc\n", "t.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 2") && e.contains("abc"), "{e}");
-        let e = Schedule::parse("step,speed_km_per_h\n3,8\n1,9\n", "t.csv").unwrap_err().to_string();
+        let e = Schedule::parse("step,speed_km_per_h\n3,8\n1,9\n", "t.csv")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 3"), "{e}");
     }
 }

@@ -68,7 +68,11 @@ pub struct Footprint {
 
 impl Default for Footprint {
     fn default() -> Self {
-        Footprint { heel: DVec3::ZERO, strike: Strike::Heel, impact_pitch: 0.0 }
+        Footprint {
+            heel: DVec3::ZERO,
+            strike: Strike::Heel,
+            impact_pitch: 0.0,
+        }
     }
 }
 
@@ -78,7 +82,8 @@ impl Footprint {
         let a = match self.strike {
             Strike::Heel => rot2(self.impact_pitch, DVec2::new(d.heel_back, d.ankle_height)),
             Strike::Toe => {
-                DVec2::new(d.heel_back + d.ankle_to_ball, d.mtp_height) - rot2(self.impact_pitch, d.mtp_f())
+                DVec2::new(d.heel_back + d.ankle_to_ball, d.mtp_height)
+                    - rot2(self.impact_pitch, d.mtp_f())
             }
         };
         self.heel + DVec3::new(a.x, a.y, 0.0)
@@ -102,7 +107,15 @@ pub type UpperAttrs = [f64; 7];
 
 /// Upper-body attributes of an effective set, in [`UpperAttrs`] order.
 pub fn upper_attrs(e: &Effective) -> UpperAttrs {
-    [e.torso_tilt, e.torso_sway, e.arm_swing, e.elbow_min, e.elbow_max, e.shoulder_rotation, e.arm_abduction]
+    [
+        e.torso_tilt,
+        e.torso_sway,
+        e.arm_swing,
+        e.elbow_min,
+        e.elbow_max,
+        e.shoulder_rotation,
+        e.arm_abduction,
+    ]
 }
 
 /// The state at a heel strike, handed from one step to the next.
@@ -287,7 +300,10 @@ pub struct StepPlan {
 }
 
 fn numerical(stage: &str, message: String) -> GenerateError {
-    GenerateError::Numerical { stage: stage.into(), message }
+    GenerateError::Numerical {
+        stage: stage.into(),
+        message,
+    }
 }
 
 /// The toe-off leg length `rad` of eq. 8: distance from the toe tip to the hip in the foot's
@@ -373,12 +389,20 @@ fn solve_case_two(problem: CaseTwo, guess: (f64, f64)) -> Result<(f64, f64), Gen
         .map_err(|e| numerical("case II Newton-Raphson", e.to_string()))?;
     let check = CaseTwo { ..problem };
     let res = Executor::new(problem, solver)
-        .configure(|s| s.param(Vector2::new(guess.0, guess.1)).max_iters(60).target_cost(1e-12))
+        .configure(|s| {
+            s.param(Vector2::new(guess.0, guess.1))
+                .max_iters(60)
+                .target_cost(1e-12)
+        })
         .run()
         .map_err(|e| numerical("case II Newton-Raphson", format!("H = {h} m: {e}")))?;
-    let p = res.state().get_best_param().copied().unwrap_or(Vector2::new(guess.0, guess.1));
+    let p = res
+        .state()
+        .get_best_param()
+        .copied()
+        .unwrap_or(Vector2::new(guess.0, guess.1));
     let r = check.apply(&p).map(|r| r.norm()).unwrap_or(f64::INFINITY);
-    if !(r < 1e-9) || !p[0].is_finite() || !p[1].is_finite() {
+    if r.is_nan() || r >= 1e-9 || !p[0].is_finite() || !p[1].is_finite() {
         return Err(numerical(
             "case II Newton-Raphson",
             format!("no toe-off pelvis gives flight height H = {h} m (residual {r:.3e}); lower H or unlock the step frequency"),
@@ -426,7 +450,13 @@ pub const STAND_KNEE: f64 = 6.0 * std::f64::consts::PI / 180.0;
 
 /// The standing pose both the start and the stop use: feet flat side by side (heels at
 /// `heel_x`, stride width apart), pelvis centred above the ankles.
-pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance_sign: f64, max_pelvis_y: f64) -> Carry {
+pub fn standing_carry(
+    d: &RunnerDims,
+    eff: &Effective,
+    heel_x: f64,
+    first_stance_sign: f64,
+    max_pelvis_y: f64,
+) -> Carry {
     let s = first_stance_sign;
     let print = |sign: f64| Footprint {
         heel: DVec3::new(heel_x, 0.0, sign * eff.stride_width / 2.0),
@@ -438,7 +468,8 @@ pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance
     let x = heel_x + d.heel_back;
     let dz = d.hip_offset.z - eff.stride_width / 2.0;
     let dd = d.hip_ankle(STAND_KNEE);
-    let y = (d.ankle_height + (dd * dd - dz * dz).max(0.0).sqrt() - d.hip_offset.y).min(max_pelvis_y);
+    let y =
+        (d.ankle_height + (dd * dd - dz * dz).max(0.0).sqrt() - d.hip_offset.y).min(max_pelvis_y);
     let pelvis = DVec3::new(x, y, 0.0);
     let hip = pelvis + d.hip_local(-s);
     let (swing, _) = leg_ik(d, hip, other.flat_ankle(d), 0.0, 0.0);
@@ -454,21 +485,43 @@ pub fn standing_carry(d: &RunnerDims, eff: &Effective, heel_x: f64, first_stance
         swing_rate: LegAngles::default(),
         standing: true,
         sway_phase: 1.5 * std::f64::consts::PI, // cos = 0: upright, rising to the forward maximum
-        upper: [0.0, 0.0, 0.0, eff.elbow_min, eff.elbow_min, 0.0, eff.arm_abduction],
+        upper: [
+            0.0,
+            0.0,
+            0.0,
+            eff.elbow_min,
+            eff.elbow_min,
+            0.0,
+            eff.arm_abduction,
+        ],
         arm_back: 0.0,
         arm_front: 0.0,
     }
 }
 
 fn hs_pose(d: &RunnerDims, print: &Footprint, hip: DVec3) -> LegAngles {
-    leg_ik(d, hip, print.impact_ankle(d), print.impact_pitch, print.impact_meta()).0
+    leg_ik(
+        d,
+        hip,
+        print.impact_ankle(d),
+        print.impact_pitch,
+        print.impact_meta(),
+    )
+    .0
 }
 
 /// Required clearance of a swinging foot at time `t` of a window [t_a, t_b] that starts
 /// (`ramp_in`) and/or ends (`ramp_out`) at a ground contact: `margin`, ramped smoothly from zero
 /// over the first/last quarter of the window (a foot leaves and reaches the ground with the
 /// joint rates of the neighbouring phase, so its height grows from zero smoothly).
-fn required_clearance(t: f64, t_a: f64, t_b: f64, ramp_in: bool, ramp_out: bool, margin: f64) -> f64 {
+fn required_clearance(
+    t: f64,
+    t_a: f64,
+    t_b: f64,
+    ramp_in: bool,
+    ramp_out: bool,
+    margin: f64,
+) -> f64 {
     // A quarter of the window, but at least CLEARANCE_RAMP: short flights (slow runs) need not
     // lift the foot a full margin within a few milliseconds.
     let q = (0.25 * (t_b - t_a)).max(CLEARANCE_RAMP);
@@ -521,7 +574,12 @@ pub struct StateKeys {
 /// Computes the state keyframes for a step whose stance foot (side sign `s`) is planted at
 /// `fp`: heel position at the end of the step, the pelvis at heel strike bottom-up, and the
 /// pelvis at toe off by case I (eqs. 7–8) or case II (Newton–Raphson on eqs. 3 and 8).
-pub fn state_keyframes(d: &RunnerDims, inp: &StepInput, s: f64, fp: &Footprint) -> Result<StateKeys, GenerateError> {
+pub fn state_keyframes(
+    d: &RunnerDims,
+    inp: &StepInput,
+    s: f64,
+    fp: &Footprint,
+) -> Result<StateKeys, GenerateError> {
     let e = inp.eff;
     let (v, sl, sf) = (inp.speed, inp.step_length, inp.step_freq);
     let t_step = 1.0 / sf;
@@ -584,7 +642,18 @@ pub fn state_keyframes(d: &RunnerDims, inp: &StepInput, s: f64, fp: &Footprint) 
         FlightSpec::Height(h) => {
             let guess_t = 0.5 * t_step;
             let (gx, gy) = case_one(guess_t).unwrap_or((x2 - v * guess_t, rad * 0.99));
-            let (x1, y1) = solve_case_two(CaseTwo { rad, off: o1, x_toe, x2, y2, v, h }, (gx, gy))?;
+            let (x1, y1) = solve_case_two(
+                CaseTwo {
+                    rad,
+                    off: o1,
+                    x_toe,
+                    x2,
+                    y2,
+                    v,
+                    h,
+                },
+                (gx, gy),
+            )?;
             (x1, y1, (x2 - x1) / v, FlightCase::II)
         }
     };
@@ -614,9 +683,13 @@ pub fn state_keyframes(d: &RunnerDims, inp: &StepInput, s: f64, fp: &Footprint) 
     })
 }
 
-
 /// Plans one running step (kind Start or Normal).
-pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind) -> Result<StepPlan, GenerateError> {
+pub fn plan_step(
+    d: &RunnerDims,
+    inp: &StepInput,
+    carry: &Carry,
+    kind: StepKind,
+) -> Result<StepPlan, GenerateError> {
     let s = carry.stance_sign;
     let e = inp.eff;
     let (v, sl, sf) = (inp.speed, inp.step_length, inp.step_freq);
@@ -630,7 +703,21 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     let t_step = 1.0 / sf;
     let fp = carry.stance_print;
     let k = state_keyframes(d, inp, s, &fp)?;
-    let StateKeys { next_print, p1, p2, t_flight, t_stance, flight_height, w, rad, case, o2, yaw1, yaw2, roll2 } = k;
+    let StateKeys {
+        next_print,
+        p1,
+        p2,
+        t_flight,
+        t_stance,
+        flight_height,
+        w,
+        rad,
+        case,
+        o2,
+        yaw1,
+        yaw2,
+        roll2,
+    } = k;
     let (x1, y1, z1) = (p1.x, p1.y, p1.z);
     let (list_max, lat_max) = (e.pelvic_list, e.lateral_displacement);
     let flight_v = DVec3::new(v, w, (p2.z - z1) / t_flight);
@@ -668,7 +755,12 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         swing: empty_track,
         eff: e,
         upper0: carry.upper,
-        sway: [(0.0, carry.sway_phase), (t_ms, std::f64::consts::TAU), (t_stance, 3.0 * std::f64::consts::PI), (t_step, 0.0)],
+        sway: [
+            (0.0, carry.sway_phase),
+            (t_ms, std::f64::consts::TAU),
+            (t_stance, 3.0 * std::f64::consts::PI),
+            (t_step, 0.0),
+        ],
         arm_back: (carry.arm_back, carry.arm_back),
         arm_front: (carry.arm_front, e.swing_hip),
         speed: v,
@@ -690,7 +782,8 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     };
     // Sway phase continues from the previous step: forward maximum (2π ≡ 0) at mid-support, back
     // maximum (3π ≡ π) at toe off, and on toward the next mid-support.
-    let end_phase = 3.0 * std::f64::consts::PI + std::f64::consts::PI * t_flight / (t_flight + t_ms);
+    let end_phase =
+        3.0 * std::f64::consts::PI + std::f64::consts::PI * t_flight / (t_flight + t_ms);
     // The previous step ended between toe off (π) and mid-support (2π), mod 2π.
     plan.sway[0].1 = carry.sway_phase.rem_euclid(std::f64::consts::TAU);
     plan.sway[3].1 = end_phase;
@@ -705,7 +798,11 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     let (dxm, dzm) = (x_ms + o_ms.x - flat_ankle.x, z_ms + o_ms.z - flat_ankle.z);
     let rm = dd_ms * dd_ms - dxm * dxm - dzm * dzm;
     let y_low = p0.y.min(y1);
-    let mut y_ms = if rm > 0.0 { flat_ankle.y + rm.sqrt() - o_ms.y } else { y_low - 0.02 };
+    let mut y_ms = if rm > 0.0 {
+        flat_ankle.y + rm.sqrt() - o_ms.y
+    } else {
+        y_low - 0.02
+    };
     // The mid-support point is the low point of support (§3.2: energies lowest there).
     y_ms = y_ms.min(y_low - 0.002 * d.body_height / 1.8);
     let lower_by = 0.01 * d.body_height / 1.8;
@@ -722,7 +819,15 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     let knee_target = e.knee_toe_off + p_eff * (inp.next_eff.swing_knee - e.knee_toe_off);
     let kr_to = 0.5 * (knee_target - e.knee_toe_off) / t_flight;
     loop {
-        build_support(&mut plan, kind, p0, carry.pelvis_vel, DVec3::new(x_ms, y_ms, z_ms), p1, flight_v);
+        build_support(
+            &mut plan,
+            kind,
+            p0,
+            carry.pelvis_vel,
+            DVec3::new(x_ms, y_ms, z_ms),
+            p1,
+            flight_v,
+        );
         find_heel_off(&mut plan, d, kr_to);
         let ok = stance_reachable(&plan, d);
         if ok || kind == StepKind::Start || plan.report.mid_support_lowered >= 12 {
@@ -753,7 +858,14 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         let a1 = a0 + DVec3::new(pl1.x - pl0.x, START_LIFT * scale, 0.0);
         let v1 = DVec3::new(vl1.x, 0.5 * START_LIFT * scale / t_lift, 0.0);
         plan.stop = StopPath {
-            ankle: [Seg3 { t0: 0.0, t1: t_lift, p0: a0, p1: a1, v0: DVec3::ZERO, v1 }; 2],
+            ankle: [Seg3 {
+                t0: 0.0,
+                t1: t_lift,
+                p0: a0,
+                p1: a1,
+                v0: DVec3::ZERO,
+                v1,
+            }; 2],
             t_land: t_lift,
             pitch0: 0.0,
             meta0: 0.0,
@@ -770,12 +882,26 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         for c in 0..5 {
             rate.set(c, (q1.get(c) - q0.get(c)) / eps);
         }
-        swing.push(Key { t: t_lift, val: q1, rate });
+        swing.push(Key {
+            t: t_lift,
+            val: q1,
+            rate,
+        });
     } else {
-        swing.push(Key { t: 0.0, val: carry.swing, rate: carry.swing_rate });
+        swing.push(Key {
+            t: 0.0,
+            val: carry.swing,
+            rate: carry.swing_rate,
+        });
     }
     let roll_sw = carry.swing.roll;
-    let ms_pose = LegAngles { pitch: 0.0, roll: roll_sw, knee: e.swing_knee, ankle: e.swing_ankle, meta: 0.0 };
+    let ms_pose = LegAngles {
+        pitch: 0.0,
+        roll: roll_sw,
+        knee: e.swing_knee,
+        ankle: e.swing_ankle,
+        meta: 0.0,
+    };
     let mut tor_pose = LegAngles {
         pitch: e.swing_hip,
         roll: roll_sw,
@@ -791,9 +917,6 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     // applied to the keyframe itself, so the flight starts from a clear foot.
     let hip_tor = hip_of(&plan, d, t_stance, -s);
     let need = TOR_CLEARANCE * d.body_height / 1.8;
-    if std::env::var("RDEBUG").is_ok() {
-        eprintln!("TOR hip {:?} pose {:?} lowest {:.4} need {need:.4} pts {:?}", hip_tor, tor_pose, leg_fk(d, hip_tor, &tor_pose).lowest(), leg_fk(d, hip_tor, &tor_pose));
-    }
     while leg_fk(d, hip_tor, &tor_pose).lowest() < need && tor_pose.pitch < 100f64.to_radians() {
         tor_pose.pitch += 2f64.to_radians();
         tor_pose.knee = toe_under_knee(d, tor_pose.pitch, tor_pose.ankle);
@@ -810,21 +933,45 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
         hs_rate.set(c, HS_RATE_MATCH * (hs_next.get(c) - hs.get(c)) / eps);
     }
     if kind != StepKind::Start {
-        let mut rate = LegAngles::default();
-        rate.pitch = (tor_pose.pitch - carry.swing.pitch) / t_stance;
-        rate.ankle = (tor_pose.ankle - carry.swing.ankle) / t_stance;
-        swing.push(Key { t: t_ms, val: ms_pose, rate });
+        let rate = LegAngles {
+            pitch: (tor_pose.pitch - carry.swing.pitch) / t_stance,
+            ankle: (tor_pose.ankle - carry.swing.ankle) / t_stance,
+            ..LegAngles::default()
+        };
+        swing.push(Key {
+            t: t_ms,
+            val: ms_pose,
+            rate,
+        });
     }
     let mut rate = LegAngles::default();
-    let (t_prev, prev) = if kind == StepKind::Start { (swing.start(), swing.keys()[0].val) } else { (t_ms, ms_pose) };
+    let (t_prev, prev) = if kind == StepKind::Start {
+        (swing.start(), swing.keys()[0].val)
+    } else {
+        (t_ms, ms_pose)
+    };
     rate.knee = (hs.knee - prev.knee) / (t_step - t_prev);
     rate.ankle = (hs.ankle - prev.ankle) / (t_step - t_prev);
-    swing.push(Key { t: t_stance, val: tor_pose, rate });
-    swing.push(Key { t: t_step, val: hs, rate: hs_rate });
+    swing.push(Key {
+        t: t_stance,
+        val: tor_pose,
+        rate,
+    });
+    swing.push(Key {
+        t: t_step,
+        val: hs,
+        rate: hs_rate,
+    });
 
     // --- Hind leg in flight: toward p of the next mid-support pose (§3.3.2). ---
     let ne = inp.next_eff;
-    let next_ms = LegAngles { pitch: 0.0, roll: to_pose.roll, knee: ne.swing_knee, ankle: ne.swing_ankle, meta: 0.0 };
+    let next_ms = LegAngles {
+        pitch: 0.0,
+        roll: to_pose.roll,
+        knee: ne.swing_knee,
+        ankle: ne.swing_ankle,
+        meta: 0.0,
+    };
     let mut target = LegAngles::default();
     let mut end_rate = LegAngles::default();
     for c in 0..5 {
@@ -835,8 +982,16 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     }
     let mut hind = Track::new();
     // The hind leg leaves the ground with the push-off's joint rates (C1 through toe off).
-    hind.push(Key { t: t_stance, val: to_pose, rate: to_rate });
-    hind.push(Key { t: t_step, val: target, rate: end_rate });
+    hind.push(Key {
+        t: t_stance,
+        val: to_pose,
+        rate: to_rate,
+    });
+    hind.push(Key {
+        t: t_step,
+        val: target,
+        rate: end_rate,
+    });
     plan.swing = swing;
     plan.hind = hind;
 
@@ -844,23 +999,54 @@ pub fn plan_step(d: &RunnerDims, inp: &StepInput, carry: &Carry, kind: StepKind)
     let margin = 0.01 * d.body_height / 1.8;
     let start = kind == StepKind::Start;
     let t_sw0 = plan.swing.start();
-    plan.report.clearance_keys += clear_track(&mut plan, d, sw, false, t_sw0, t_step, start, true, margin);
-    plan.report.clearance_keys += clear_track(&mut plan, d, s, true, t_stance, t_step, true, false, margin);
+    plan.report.clearance_keys +=
+        clear_track(&mut plan, d, sw, false, t_sw0, t_step, start, true, margin);
+    plan.report.clearance_keys +=
+        clear_track(&mut plan, d, s, true, t_stance, t_step, true, false, margin);
     Ok(plan)
 }
 
-fn build_support(plan: &mut StepPlan, kind: StepKind, p0: DVec3, v0: DVec3, pms: DVec3, p1: DVec3, v1: DVec3) {
+fn build_support(
+    plan: &mut StepPlan,
+    kind: StepKind,
+    p0: DVec3,
+    v0: DVec3,
+    pms: DVec3,
+    p1: DVec3,
+    v1: DVec3,
+) {
     let t_st = plan.t_stance;
     if kind == StepKind::Start {
         // From a stand the pelvis rises straight to toe off (no dip: the runner pushes off).
-        plan.support[0] = Seg3 { t0: 0.0, t1: t_st, p0, p1, v0, v1 };
+        plan.support[0] = Seg3 {
+            t0: 0.0,
+            t1: t_st,
+            p0,
+            p1,
+            v0,
+            v1,
+        };
         plan.nseg = 1;
         return;
     }
     let h = 0.5 * t_st;
     let vm = c2_mid_velocity(p0, p1, v0, v1, h);
-    plan.support[0] = Seg3 { t0: 0.0, t1: h, p0, p1: pms, v0, v1: vm };
-    plan.support[1] = Seg3 { t0: h, t1: t_st, p0: pms, p1, v0: vm, v1 };
+    plan.support[0] = Seg3 {
+        t0: 0.0,
+        t1: h,
+        p0,
+        p1: pms,
+        v0,
+        v1: vm,
+    };
+    plan.support[1] = Seg3 {
+        t0: h,
+        t1: t_st,
+        p0: pms,
+        p1,
+        v0: vm,
+        v1,
+    };
     plan.nseg = 2;
 }
 
@@ -915,7 +1101,11 @@ fn find_heel_off(plan: &mut StepPlan, d: &RunnerDims, kr_to: f64) {
     let tb = (found - e).max(0.0);
     let hb = hip_of(plan, d, tb, s);
     let (ab, _) = leg_ik(d, hb, ankle, 0.0, 0.0);
-    let kr0 = if found > tb { (a0.knee - ab.knee) / (found - tb) } else { 0.0 };
+    let kr0 = if found > tb {
+        (a0.knee - ab.knee) / (found - tb)
+    } else {
+        0.0
+    };
     let dur = (plan.t_stance - found).max(1e-6);
     plan.heel_off = HeelOff {
         k0: a0.knee,
@@ -977,7 +1167,8 @@ fn clear_track(
             let (ang, _) = track.eval(t);
             let pts = leg_fk(d, hip_of(plan, d, t, sign), &ang);
             // Half a millimetre of slack: the generator's own penetration bound is 1 mm.
-            let deficit = required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.0005;
+            let deficit =
+                required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.0005;
             if deficit > worst.0 {
                 worst = (deficit, t);
             }
@@ -985,7 +1176,7 @@ fn clear_track(
         worst
     };
     let (deficit, t_worst) = worst(plan);
-    if deficit <= 0.0 || std::env::var("RNOBUMP").is_ok() {
+    if deficit <= 0.0 {
         return 0;
     }
     // The bump's peak is kept off the window's ends so the extra flexion builds up smoothly.
@@ -1000,7 +1191,11 @@ fn clear_track(
     let mut deficit = deficit;
     let lever = 0.5 * d.shank;
     while deficit > 0.0 && raises < 16 {
-        let track = if hind { &mut plan.hind } else { &mut plan.swing };
+        let track = if hind {
+            &mut plan.hind
+        } else {
+            &mut plan.swing
+        };
         track.bump = KneeBump {
             t0: t_a,
             peak: t_peak,
@@ -1010,9 +1205,6 @@ fn clear_track(
         };
         raises += 1;
         deficit = worst(plan).0;
-    }
-    if std::env::var("RDEBUG").is_ok() {
-        eprintln!("clear hind={hind} peak {t_peak:.4} raises {raises} left {deficit:.4}");
     }
     raises
 }
@@ -1059,7 +1251,12 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     // capped at STOP_TIME.
     let x_end = stance_ankle.x + STOP_STAGGER * scale;
     let dx_total = (x_end - carry.pelvis.x).max(0.02 * scale);
-    let t_stop = if v0 > 1e-6 { (2.9 * dx_total / v0).min(STOP_TIME * scale.sqrt()) } else { STOP_TIME * scale.sqrt() }.max(0.25);
+    let t_stop = if v0 > 1e-6 {
+        (2.9 * dx_total / v0).min(STOP_TIME * scale.sqrt())
+    } else {
+        STOP_TIME * scale.sqrt()
+    }
+    .max(0.25);
     let dz = d.hip_offset.z - eff.stride_width / 2.0;
     // Come to rest with the knees a little bent, so both legs reach the ground throughout.
     let dd = d.hip_ankle(STOP_KNEE);
@@ -1068,19 +1265,41 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     let y_end = y_hip - d.hip_offset.y;
     let p_end = DVec3::new(x_end, y_end, 0.0);
     let final_print = Footprint {
-        heel: DVec3::new(2.0 * x_end - stance_ankle.x - d.heel_back, 0.0, -s * eff.stride_width / 2.0),
+        heel: DVec3::new(
+            2.0 * x_end - stance_ankle.x - d.heel_back,
+            0.0,
+            -s * eff.stride_width / 2.0,
+        ),
         strike: eff.strike,
         impact_pitch: 0.0,
     };
     // Two spline segments like a support phase: through a mid-support point over the stance
     // foot (lateral displacement toward it, as in Fig. 7) to rest centred between the feet.
     let lat = eff.lateral_displacement;
-    let mut p_mid = DVec3::new(0.5 * (carry.pelvis.x + x_end), carry.pelvis.y.min(y_end), s * lat);
+    let mut p_mid = DVec3::new(
+        0.5 * (carry.pelvis.x + x_end),
+        carry.pelvis.y.min(y_end),
+        s * lat,
+    );
     let h = 0.5 * t_stop;
     let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
     let support = [
-        Seg3 { t0: 0.0, t1: h, p0: carry.pelvis, p1: p_mid, v0: carry.pelvis_vel, v1: v_mid },
-        Seg3 { t0: h, t1: t_stop, p0: p_mid, p1: p_end, v0: v_mid, v1: DVec3::ZERO },
+        Seg3 {
+            t0: 0.0,
+            t1: h,
+            p0: carry.pelvis,
+            p1: p_mid,
+            v0: carry.pelvis_vel,
+            v1: v_mid,
+        },
+        Seg3 {
+            t0: h,
+            t1: t_stop,
+            p0: p_mid,
+            p1: p_end,
+            v0: v_mid,
+            v1: DVec3::ZERO,
+        },
     ];
     let t_flat = (0.12 * scale.sqrt()).min(0.4 * t_stop);
     let mut plan = StepPlan {
@@ -1096,7 +1315,12 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         nseg: 2,
         flight_p1: p_end,
         flight_v: DVec3::ZERO,
-        orient: [(0.0, carry.yaw, carry.roll), (0.5 * t_stop, 0.0, 0.0), (t_stop, 0.0, 0.0), (t_stop, 0.0, 0.0)],
+        orient: [
+            (0.0, carry.yaw, carry.roll),
+            (0.5 * t_stop, 0.0, 0.0),
+            (t_stop, 0.0, 0.0),
+            (t_stop, 0.0, 0.0),
+        ],
         norient: 3,
         stance_print: fp,
         next_print: final_print,
@@ -1106,14 +1330,22 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         swing: Track::new(),
         eff: *eff,
         upper0: carry.upper,
-        sway: [(0.0, carry.sway_phase), (t_stop, carry.sway_phase), (t_stop, carry.sway_phase), (t_stop, carry.sway_phase)],
+        sway: [
+            (0.0, carry.sway_phase),
+            (t_stop, carry.sway_phase),
+            (t_stop, carry.sway_phase),
+            (t_stop, carry.sway_phase),
+        ],
         arm_back: (carry.arm_back, carry.arm_back),
         arm_front: (carry.arm_front, carry.arm_front),
         speed: 0.0,
         step_length: 0.0,
         step_freq: 0.0,
         stop: StopPath::default(),
-        report: StepReport { t_stance: t_stop, ..StepReport::default() },
+        report: StepReport {
+            t_stance: t_stop,
+            ..StepReport::default()
+        },
     };
     // Recovery 1 as in a running step: lower the mid-support point while the stance hip is
     // out of reach.
@@ -1121,8 +1353,22 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         p_mid.y -= 0.01 * scale;
         let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
         plan.support = [
-            Seg3 { t0: 0.0, t1: h, p0: carry.pelvis, p1: p_mid, v0: carry.pelvis_vel, v1: v_mid },
-            Seg3 { t0: h, t1: t_stop, p0: p_mid, p1: p_end, v0: v_mid, v1: DVec3::ZERO },
+            Seg3 {
+                t0: 0.0,
+                t1: h,
+                p0: carry.pelvis,
+                p1: p_mid,
+                v0: carry.pelvis_vel,
+                v1: v_mid,
+            },
+            Seg3 {
+                t0: h,
+                t1: t_stop,
+                p0: p_mid,
+                p1: p_end,
+                v0: v_mid,
+                v1: DVec3::ZERO,
+            },
         ];
         plan.report.mid_support_lowered += 1;
     }
@@ -1134,7 +1380,13 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     for c in 0..5 {
         ahead.set(c, carry.swing.get(c) + e * carry.swing_rate.get(c));
     }
-    let hip_e = hip_at(d, carry.pelvis + e * carry.pelvis_vel, carry.yaw, carry.roll, -s);
+    let hip_e = hip_at(
+        d,
+        carry.pelvis + e * carry.pelvis_vel,
+        carry.yaw,
+        carry.roll,
+        -s,
+    );
     let va0 = (leg_fk(d, hip_e, &ahead).ankle - pts0.ankle) / e;
     let land = final_print.flat_ankle(d);
     let t_land = 0.8 * t_stop;
@@ -1143,11 +1395,29 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         pts0.ankle.y.max(land.y) + 0.06 * d.body_height / 1.8,
         0.5 * (pts0.ankle.z + land.z),
     );
-    let vmid = DVec3::new((land.x - pts0.ankle.x) / t_land, 0.0, (land.z - pts0.ankle.z) / t_land);
+    let vmid = DVec3::new(
+        (land.x - pts0.ankle.x) / t_land,
+        0.0,
+        (land.z - pts0.ankle.z) / t_land,
+    );
     plan.stop = StopPath {
         ankle: [
-            Seg3 { t0: 0.0, t1: 0.5 * t_land, p0: pts0.ankle, p1: mid, v0: va0, v1: vmid },
-            Seg3 { t0: 0.5 * t_land, t1: t_land, p0: mid, p1: land, v0: vmid, v1: DVec3::new(0.0, -0.3, 0.0) },
+            Seg3 {
+                t0: 0.0,
+                t1: 0.5 * t_land,
+                p0: pts0.ankle,
+                p1: mid,
+                v0: va0,
+                v1: vmid,
+            },
+            Seg3 {
+                t0: 0.5 * t_land,
+                t1: t_land,
+                p0: mid,
+                p1: land,
+                v0: vmid,
+                v1: DVec3::new(0.0, -0.3, 0.0),
+            },
         ],
         t_land,
         pitch0: carry.swing.foot_pitch(),
@@ -1174,7 +1444,13 @@ mod tests {
         let (k, a, m) = (0.35, -0.6, 0.5);
         let rad = toe_off_radius(&d, k, a, m, 0.0).unwrap();
         for pitch in [-0.5, -0.2, 0.1] {
-            let ang = LegAngles { pitch, roll: 0.0, knee: k, ankle: a, meta: m };
+            let ang = LegAngles {
+                pitch,
+                roll: 0.0,
+                knee: k,
+                ankle: a,
+                meta: m,
+            };
             let p = leg_fk(&d, DVec3::ZERO, &ang);
             assert!(((p.toe - p.hip).length() - rad).abs() < 1e-12);
         }
@@ -1187,14 +1463,30 @@ mod tests {
         let v = 12.0 / 3.6;
         let sl = 1.0694;
         let sf = v / sl;
-        let eff = attrs.effective(&Drivers { speed: v, step_length: sl, step_freq: sf, flight_height: 0.004 });
+        let eff = attrs.effective(&Drivers {
+            speed: v,
+            step_length: sl,
+            step_freq: sf,
+            flight_height: 0.004,
+        });
         let mut carry = standing_carry(&d, &eff, 0.0, 1.0, f64::INFINITY);
         carry.standing = false;
         carry.pelvis_vel = DVec3::new(v, -1.0, 0.0);
-        let inp = StepInput { speed: v, step_length: sl, step_freq: sf, flight: FlightSpec::Time(0.188), eff, next_eff: eff, p: 0.75 };
+        let inp = StepInput {
+            speed: v,
+            step_length: sl,
+            step_freq: sf,
+            flight: FlightSpec::Time(0.188),
+            eff,
+            next_eff: eff,
+            p: 0.75,
+        };
         let one = plan_step(&d, &inp, &carry, StepKind::Normal).unwrap();
         let h = one.report.flight_height;
-        let inp2 = StepInput { flight: FlightSpec::Height(h), ..inp };
+        let inp2 = StepInput {
+            flight: FlightSpec::Height(h),
+            ..inp
+        };
         let two = plan_step(&d, &inp2, &carry, StepKind::Normal).unwrap();
         assert_eq!(two.report.case, Some(FlightCase::II));
         assert!((two.t_flight - 0.188).abs() < 1e-9, "{}", two.t_flight);

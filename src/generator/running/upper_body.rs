@@ -61,11 +61,23 @@ pub fn upper_at(plan: &StepPlan, t: f64) -> UpperAttrs {
     let target = match plan.kind {
         StepKind::Stop => {
             let e = &plan.eff;
-            [0.0, 0.0, 0.0, e.elbow_min, e.elbow_min, 0.0, e.arm_abduction]
+            [
+                0.0,
+                0.0,
+                0.0,
+                e.elbow_min,
+                e.elbow_min,
+                0.0,
+                e.arm_abduction,
+            ]
         }
         _ => super::state::upper_attrs(&plan.eff),
     };
-    let span = if plan.kind == StepKind::Stop { plan.t_step } else { plan.t_ms.max(1e-6) };
+    let span = if plan.kind == StepKind::Stop {
+        plan.t_step
+    } else {
+        plan.t_ms.max(1e-6)
+    };
     let s = smooth01(t / span);
     let mut u = plan.upper0;
     for (a, b) in u.iter_mut().zip(target.iter()) {
@@ -84,7 +96,11 @@ fn sway_phase(plan: &StepPlan, t: f64) -> f64 {
     for i in 0..3 {
         if t <= k[i + 1].0 || i == 2 {
             let (a, b) = (k[i], k[i + 1]);
-            let s = if b.0 > a.0 { ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0) } else { 1.0 };
+            let s = if b.0 > a.0 {
+                ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
             return a.1 + s * (b.1 - a.1);
         }
     }
@@ -96,7 +112,14 @@ fn sway_phase(plan: &StepPlan, t: f64) -> f64 {
 /// `drivers[i]` is the arm-swing driver of leg `i` (`[left, right]`); the left arm follows the
 /// right leg and vice versa.
 #[inline]
-pub fn fill_upper(plan: &StepPlan, t: f64, yaw: f64, roll: f64, drivers: [f64; 2], pose: &mut Pose) {
+pub fn fill_upper(
+    plan: &StepPlan,
+    t: f64,
+    yaw: f64,
+    roll: f64,
+    drivers: [f64; 2],
+    pose: &mut Pose,
+) {
     let u = upper_at(plan, t);
     let [tilt, sway, swing, el_min, el_max, counter, abd] = u;
     let lean = tilt + sway * sway_phase(plan, t).cos();
@@ -121,13 +144,25 @@ pub fn fill_upper(plan: &StepPlan, t: f64, yaw: f64, roll: f64, drivers: [f64; 2
     };
     let front = swing * arm_front;
     let back = swing * arm_back;
-    let stop_fade = if plan.kind == StepKind::Stop { 1.0 - smooth01(t / plan.t_step) } else { 1.0 };
+    let stop_fade = if plan.kind == StepKind::Stop {
+        1.0 - smooth01(t / plan.t_step)
+    } else {
+        1.0
+    };
     for (side, sign) in [(0usize, -1.0f64), (1usize, 1.0f64)] {
         let flex = swing * drivers[1 - side] * stop_fade;
         let span = front - back;
-        let frac = if span > 1e-6 { ((flex - back) / span).clamp(0.0, 1.0) } else { 0.5 };
+        let frac = if span > 1e-6 {
+            ((flex - back) / span).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
         let (elbow, _) = hermite(0.0, 1.0, el_min, el_max, 0.0, 0.0, frac);
-        let (shoulder, elbow_j) = if side == 0 { (Joint::LShoulder, Joint::LElbow) } else { (Joint::RShoulder, Joint::RElbow) };
+        let (shoulder, elbow_j) = if side == 0 {
+            (Joint::LShoulder, Joint::LElbow)
+        } else {
+            (Joint::RShoulder, Joint::RElbow)
+        };
         r[shoulder.index()] = DQuat::from_rotation_z(flex) * DQuat::from_rotation_x(-sign * abd);
         r[elbow_j.index()] = DQuat::from_rotation_z(elbow);
     }
