@@ -279,7 +279,9 @@ mod tests {
         let s = Schedule::parse("speed_km_per_h,action\n8,\n12,\n,stop\n", "t.csv").unwrap();
         assert_eq!(s.rows.len(), 3);
         assert_eq!(s.rows[1].step, 1);
-        assert_eq!(s.rows[1].set, vec![(Param::Speed, 12.0 / 3.6)]);
+        assert_eq!(s.rows[1].set.len(), 1);
+        assert_eq!(s.rows[1].set[0].0, Param::Speed);
+        assert!((s.rows[1].set[0].1 - 12.0 / 3.6).abs() < 1e-12);
         assert!(s.rows[2].stop && s.stops());
         let e = Schedule::parse("speed_furlongs\n1\n", "t.csv")
             .unwrap_err()
