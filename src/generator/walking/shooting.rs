@@ -101,8 +101,15 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
         }
         last_width = width;
         let fc = eval(c, &mut evals);
-        if fc.abs() <= tol || (b - a).abs() < 1e-15 * (1.0 + c.abs()) {
+        if fc.abs() <= tol {
             return done(c, fc, evals);
+        }
+        if (b - a).abs() < 1e-13 * (1.0 + c.abs()) {
+            // The bracket has collapsed onto a jump of the residual (no exact root in floating
+            // point): return the better end; the caller reports the remaining error.
+            let (x, r) = if fa.abs() < fb.abs() { (a, fa) } else { (b, fb) };
+            let (x, r) = if fc.abs() < r.abs() { (c, fc) } else { (x, r) };
+            return done(x, r, evals);
         }
         if fc.signum() == fb.signum() {
             b = c;
@@ -215,20 +222,25 @@ pub fn solve_2d<F: FnMut([f64; 2]) -> [f64; 2]>(
             break;
         }
         // Alternating one-dimensional bracketed solves give a better start.
-        for _ in 0..2 {
+        for _ in 0..3 {
             for j in 0..2 {
                 let mut g = |v: f64| {
                     let mut xx = x;
                     xx[j] = v;
                     f(xx)[j]
                 };
-                let budget = max_evals.saturating_sub(evals).max(1);
+                let budget = max_evals.saturating_sub(evals).clamp(1, 40);
                 match solve_1d(&mut g, x[j], dx[j] * 10.0, tol[j], budget) {
                     Ok(s) => {
                         x[j] = s.x[0];
                         evals += s.iterations;
                     }
-                    Err(_) => return Err(format!("no convergence in {evals} simulations")),
+                    Err(e) => {
+                        return Err(format!(
+                            "no convergence in {evals} simulations (unknown {}: {e})",
+                            j + 1
+                        ))
+                    }
                 }
             }
         }

@@ -115,6 +115,11 @@ impl StanceSpec {
         ext: (f64, f64, f64),
         floor: f64,
     ) -> [f64; 7] {
+        // Far outside any walking posture (a trial force that makes the pendulum fall): freeze
+        // the state, so the shooting residual stays finite and keeps its sign.
+        if y[1].abs() > 1.3 || y[0] < 0.3 * self.l1 || y[0] > 1.6 * self.l1 || y[2].abs() > 1.3 {
+            return [0.0; 7];
+        }
         let q = [y[0], y[1], y[2]];
         let qd = [y[3], y[4], y[5]];
         let f = self.forces(t, y, a, sub, ext);
@@ -266,7 +271,7 @@ impl StanceSpec {
             let r = self.run(start, x[0], x[1], h, false);
             [r.end[1] - self.target[1], r.end[0] - self.target[0]]
         };
-        let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 80)?;
+        let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 160)?;
         let run = self.run(start, solved.x[0], solved.x[1], h, true);
         Ok((solved, run))
     }
