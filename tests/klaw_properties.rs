@@ -11,10 +11,24 @@ use gaitfit::generator::walking::high_level::phase_times;
 use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
 use proptest::prelude::*;
 
-fn walk(kmh: f64, h: f64, steps: usize) -> (gaitfit::generator::motion::Motion, gaitfit::generator::walking::WalkReport, WalkOptions) {
-    let opts = WalkOptions { height_m: h, ..Default::default() };
+fn walk(
+    kmh: f64,
+    h: f64,
+    steps: usize,
+) -> (
+    gaitfit::generator::motion::Motion,
+    gaitfit::generator::walking::WalkReport,
+    WalkOptions,
+) {
+    let opts = WalkOptions {
+        height_m: h,
+        ..Default::default()
+    };
     let sched = [ScheduleEntry {
-        params: WalkParams { speed_m_per_s: Some(kmh / 3.6), ..Default::default() },
+        params: WalkParams {
+            speed_m_per_s: Some(kmh / 3.6),
+            ..Default::default()
+        },
         steps,
     }];
     let (m, r) = generate_walk(&sched, &opts).unwrap();
@@ -72,7 +86,10 @@ fn slow_and_fast_walks_converge() {
         let (_, r, _) = walk(kmh, h, 4);
         for s in &r.steps {
             for e in &s.errors[1..] {
-                assert!(e.abs() < 0.1f64.to_radians(), "{kmh} km/h, h = {h}: error {e}");
+                assert!(
+                    e.abs() < 0.1f64.to_radians(),
+                    "{kmh} km/h, h = {h}: error {e}"
+                );
             }
         }
     }

@@ -107,7 +107,11 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
         if (b - a).abs() < 1e-13 * (1.0 + c.abs()) {
             // The bracket has collapsed onto a jump of the residual (no exact root in floating
             // point): return the better end; the caller reports the remaining error.
-            let (x, r) = if fa.abs() < fb.abs() { (a, fa) } else { (b, fb) };
+            let (x, r) = if fa.abs() < fb.abs() {
+                (a, fa)
+            } else {
+                (b, fb)
+            };
             let (x, r) = if fc.abs() < r.abs() { (c, fc) } else { (x, r) };
             return done(x, r, evals);
         }
