@@ -1,6 +1,6 @@
 //! `kb-mu`: the bounded fit of the μ-functions (Ko & Badler 1993, appendix A) against an
 //! independent closed form, on synthetic data with known coefficients, and the committed
-//! `fits/kb-mu.json` against a refit of the bundled trials tables.
+//! `fits/ko-badler/kb-mu.json` against a refit of the bundled trials tables.
 use gaitfit::generator::generalize::prototype::Prototype;
 use gaitfit::generator::generalize::DEFAULT_ALPHA;
 use gaitfit::relations::kb_mu::{bounds, fit, fit_tables, separable_line, MuObservation};
@@ -101,13 +101,13 @@ fn reports_an_active_bound() {
     assert!((f.alpha()[0] - 0.3).abs() < 1e-6);
 }
 
-/// `fits/kb-mu.json` is what refitting the bundled tables gives, and the generator's default
+/// `fits/ko-badler/kb-mu.json` is what refitting the bundled tables gives, and the generator's default
 /// slopes are its α.
 #[test]
 fn committed_fit_is_reproducible_and_is_the_default() {
     let p = Prototype::bundled();
     let f = fit_tables(&bundled_tables(), &p, None).unwrap();
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fits/kb-mu.json");
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fits/ko-badler/kb-mu.json");
     let set = gaitfit::relations::CoefficientSet::from_fit_file(&path).unwrap();
     assert_eq!(set.relation, "kb-mu");
     for c in &f.coefficients {

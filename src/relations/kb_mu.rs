@@ -194,7 +194,7 @@ pub struct PerMu {
     pub x_range_m: [f64; 2],
 }
 
-/// The fitted μ-functions with their statistics (written as `fits/kb-mu.json`).
+/// The fitted μ-functions with their statistics (written as `fits/ko-badler/kb-mu.json`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct KbMuFit {
     /// `kb-mu`.

@@ -10,7 +10,7 @@
 //!
 //! A schedule is a CSV with a `step_length_m` column and optionally `duration_s` (one row per
 //! step). Without `--prototype` the bundled Winter prototype is used; without `--alpha` the
-//! μ-function slopes come from `fits/kb-mu.json` when it exists, else from the built-in values
+//! μ-function slopes come from `fits/ko-badler/kb-mu.json` when it exists, else from the built-in values
 //! (the committed fit).
 use crate::events::Side;
 use crate::generator::generalize::figure::{
@@ -44,14 +44,14 @@ pub struct Options {
     /// Write the prototype in use to this JSON file (how `data/prototype_winter.json` is made).
     #[arg(long, value_name = "FILE")]
     pub write_prototype: Option<PathBuf>,
-    /// μ-function slopes α1,α2,α3,α4 in rad/m (default: fits/kb-mu.json, else built in).
+    /// μ-function slopes α1,α2,α3,α4 in rad/m (default: fits/ko-badler/kb-mu.json, else built in).
     #[arg(long, value_delimiter = ',', num_args = 4, value_name = "A1,A2,A3,A4")]
     pub alpha: Option<Vec<f64>>,
     /// The kb-mu fit to take α from.
-    #[arg(long, value_name = "FILE", default_value = "fits/kb-mu.json")]
+    #[arg(long, value_name = "FILE", default_value = "fits/ko-badler/kb-mu.json")]
     pub mu_fit: PathBuf,
     /// Fit the μ-function slopes (relation `kb-mu`) on these trials tables and write the fit to
-    /// --mu-fit (the regeneration command of `fits/kb-mu.json`, until `gaitfit fit` takes
+    /// --mu-fit (the regeneration command of `fits/ko-badler/kb-mu.json`, until `gaitfit fit` takes
     /// relations with several observations per row).
     #[arg(long, value_name = "CSV", num_args = 1..)]
     pub fit_mu: Option<Vec<PathBuf>>,

@@ -48,7 +48,7 @@ pub use walk_data::{AngleSequence, Anthropometry, Moments, PathSequence, TimedSe
 use crate::generator::GenerateError;
 
 /// The μ-function slopes α₁…α₄ (rad/m) used when no fit is given: the values of the committed
-/// `fits/kb-mu.json` (relation `kb-mu`, fitted on the bundled trials tables; α₁ sits on its
+/// `fits/ko-badler/kb-mu.json` (relation `kb-mu`, fitted on the bundled trials tables; α₁ sits on its
 /// lower bound 0 — measured knees flex *more* at heel strike in longer steps), checked by
 /// `tests/kb_mu_fit.rs`.
 pub const DEFAULT_ALPHA: [f64; 4] = [
