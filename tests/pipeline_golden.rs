@@ -15,16 +15,34 @@ fn refitting_bundled_data_reproduces_committed_fits() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let fits = read_fits_dir(&root.join("fits")).expect("fits/ readable");
     let have_data = std::fs::read_dir(root.join("data"))
-        .map(|d| d.filter_map(|e| e.ok()).any(|e| e.path().extension().is_some_and(|x| x == "csv")))
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .any(|e| e.path().extension().is_some_and(|x| x == "csv"))
+        })
         .unwrap_or(false);
     if have_data {
-        assert!(fits.len() >= 5, "data/*.csv exist but fits/ has {} records: run `gaitfit fit`", fits.len());
+        assert!(
+            fits.len() >= 5,
+            "data/*.csv exist but fits/ has {} records: run `gaitfit fit`",
+            fits.len()
+        );
     }
     for (path, committed) in fits {
-        let files: Vec<PathBuf> = committed.data.files.iter().map(|f| root.join(&f.path)).collect();
+        let files: Vec<PathBuf> = committed
+            .data
+            .files
+            .iter()
+            .map(|f| root.join(&f.path))
+            .collect();
         let tables = load_tables(&files, None).expect("committed data readable");
         for (t, f) in tables.iter().zip(&committed.data.files) {
-            assert_eq!(t.sha256, f.sha256, "{} changed since {} was fitted: rerun `gaitfit fit`", f.path, path.display());
+            assert_eq!(
+                t.sha256,
+                f.sha256,
+                "{} changed since {} was fitted: rerun `gaitfit fit`",
+                f.path,
+                path.display()
+            );
         }
         let rel = by_id(&committed.relation).unwrap();
         let opts = FitOptions {
@@ -38,8 +56,21 @@ fn refitting_bundled_data_reproduces_committed_fits() {
         assert_eq!(now.coefficients.len(), committed.coefficients.len());
         for (a, b) in now.coefficients.iter().zip(&committed.coefficients) {
             assert_eq!(a.name, b.name);
-            assert!(close(a.value, b.value), "{} {}: {} vs committed {}", committed.relation, a.name, a.value, b.value);
-            assert_eq!(a.held.is_some(), b.held.is_some(), "{} {}", committed.relation, a.name);
+            assert!(
+                close(a.value, b.value),
+                "{} {}: {} vs committed {}",
+                committed.relation,
+                a.name,
+                a.value,
+                b.value
+            );
+            assert_eq!(
+                a.held.is_some(),
+                b.held.is_some(),
+                "{} {}",
+                committed.relation,
+                a.name
+            );
         }
         for (what, a, b) in [
             ("r2", now.r2, committed.r2),
@@ -47,7 +78,11 @@ fn refitting_bundled_data_reproduces_committed_fits() {
             ("loo_rmse", now.loo_rmse, committed.loo_rmse),
             ("aic", now.aic, committed.aic),
         ] {
-            assert!(close(a, b), "{} {what}: {a} vs committed {b}", committed.relation);
+            assert!(
+                close(a, b),
+                "{} {what}: {a} vs committed {b}",
+                committed.relation
+            );
         }
         match (now.loso_rmse, committed.loso_rmse) {
             (Some(a), Some(b)) => assert!(close(a, b), "{} loso", committed.relation),
