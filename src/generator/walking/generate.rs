@@ -177,10 +177,12 @@ impl Determinants {
             )
     }
     /// Swing hip minus the dynamic hip in the sagittal plane `(dx, dy)` (the stance hip is at
-    /// `(−dx_offset, 0)`; see [`Determinants::swing_offset`]).
+    /// `(−dx_offset, 0)`; see [`Determinants::swing_offset`]): with the pelvis rotation
+    /// `Rx(±λ)·Ry(±ψ)`, `(a·sin ψ, −2a·cos ψ·sin λ)`, `a` half the pelvis width.
     pub fn swing_hip_offset(&self, t: f64) -> [f64; 2] {
-        let o = self.swing_offset(t);
-        [o.x, 2.0 * o.y]
+        let (sp, cp) = self.rotation_at(t).sin_cos();
+        let a = self.half_width;
+        [a * sp, -2.0 * a * cp * self.list_at(t).sin()]
     }
 }
 
@@ -394,7 +396,7 @@ pub fn generate_steps(
             (h.pos, det.lateral_at(t) + o.z)
         };
         // 2. The trailing leg completes its stance through the double support.
-        let dt_v = 1e-3;
+        let dt_v = 2e-3;
         let t_ds = times.double_support;
         trailing.toe_off_time = trailing_clock + t_ds;
         let mut trail_rho = Vec::new();
@@ -780,4 +782,34 @@ fn place_leg(
     let h = g.position(hip);
     let kn = g.position(Joint::leg(side)[1]);
     (h.x - kn.x).atan2(h.y - kn.y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn swing_hip_offset_matches_the_pelvis_rotation() {
+        for swing in [Side::Left, Side::Right] {
+            let d = Determinants {
+                duration: 0.56,
+                rotation: 0.07,
+                list: 0.08,
+                lateral: 0.02,
+                half_width: 0.09,
+                swing,
+                from_rest: false,
+                to_rest: false,
+            };
+            for k in 0..=20 {
+                let t = 0.56 * k as f64 / 20.0;
+                let o = d.swing_offset(t);
+                let a = d.swing_hip_offset(t);
+                assert!((a[0] - o.x).abs() < 1e-12 && (a[1] - 2.0 * o.y).abs() < 1e-12);
+            }
+            // Rotation: swing hip behind at the start, ahead at heel strike; list 0 at both.
+            assert!(d.swing_hip_offset(0.0)[0] < 0.0 && d.swing_hip_offset(0.56)[0] > 0.0);
+            assert!(d.swing_hip_offset(0.28)[1] < 0.0 && d.swing_hip_offset(0.0)[1].abs() < 1e-12);
+        }
+    }
 }

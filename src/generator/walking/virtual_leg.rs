@@ -152,7 +152,7 @@ impl VirtualLeg {
             } else {
                 b = m;
             }
-            if b - a < 1e-12 {
+            if b - a < 1e-10 {
                 break;
             }
         }
@@ -186,7 +186,7 @@ impl VirtualLeg {
                         } else {
                             a = m;
                         }
-                        if b - a < 1e-12 {
+                        if b - a < 1e-10 {
                             break;
                         }
                     }
