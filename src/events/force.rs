@@ -198,9 +198,9 @@ pub fn vertical_force(
     }
     if p2 > 0.25 * p98 {
         return Err(plate_err(format!(
-            "never unloaded (lowest force {p2:.0} N, peak {p98:.0} N): a single belt carrying \
-             both feet cannot be split into foot contacts; use markers (--events zeni) or \
-             per-belt forces"
+            "never unloaded (lowest force {p2:.0} N, peak {p98:.0} N): a standing trial has \
+             no gait events, and a single belt carrying both feet cannot be split into foot \
+             contacts; use markers (--events zeni) or per-belt forces"
         )));
     }
     // Unloaded samples: within `off_n` of the lowest level.

@@ -282,8 +282,9 @@ pub fn steps_from_analysis(
         for w in h.windows(2) {
             let (ta, tc) = (w[0].time_s, w[1].time_s);
             let stride_t = tc - ta;
-            let stride_len = match (heel_at(side, ta), heel_at(side, tc)) {
-                (Some(a), Some(c)) => Some(c - a + v_belt * stride_t),
+            let stride_len = match (heel_at(side, ta), heel_at(side, tc), setting) {
+                (_, _, Setting::Unknown) => None,
+                (Some(a), Some(c), _) => Some(c - a + v_belt * stride_t),
                 _ => belt.map(|v| v * stride_t),
             };
             let mut row = base_row(side, ta);
@@ -366,13 +367,19 @@ pub fn steps_from_analysis(
                 // t_cycle = 2 / sf, the walking paper's §3 (and the trials schema's) definition.
                 row.double_support_pct_cycle = Some((t2 - ta) / (2.0 * step_t) * 100.0);
             }
-            // Step length.
-            let (sl, method) = match (heel_at(a.side, ta), heel_at(b.side, tb)) {
-                (Some(xa), Some(xb)) => (
+            // Step length. On a treadmill of unknown speed the heels alone say nothing.
+            let heel_pair = match setting {
+                Setting::Overground | Setting::Treadmill { .. } => {
+                    heel_at(a.side, ta).zip(heel_at(b.side, tb))
+                }
+                Setting::Unknown => None,
+            };
+            let (sl, method) = match heel_pair {
+                Some((xa, xb)) => (
                     Some(xb - xa + v_belt * step_t),
                     if belt.is_some() { "belt+heel" } else { "heel" },
                 ),
-                _ => match (belt, cop_axis) {
+                None => match (belt, cop_axis) {
                     (Some(v), Some((fwd, sign))) => {
                         match (
                             contact_at(a.side, ta).and_then(|c| belt_cop(c, fwd, sign, v)),
