@@ -1,11 +1,252 @@
-//! `gaitfit generate run`.
+//! `gaitfit generate run`: RUNNER (Bruderlin & Calvert 1996), a run from a stand at a speed (and
+//! optionally step length, step frequency, flight height, level, attributes, a per-step
+//! schedule), written as BVH, CSV (+ events CSV) or TRC.
+use crate::generator::running::attributes::{unit_name, AttrUnit, SPECS};
+use crate::generator::running::equations::RunRelations;
+use crate::generator::running::params::default_mass;
+use crate::generator::running::schedule::parse_value;
+use crate::generator::running::{
+    generate_run, Attr, GenerateOptions, Param, RunAttributes, RunModel, Schedule,
+};
+use crate::generator::skeleton::Skeleton;
+use crate::units::Dimension;
+use anyhow::{bail, Context};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 /// Arguments of `gaitfit generate run`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(after_long_help = attribute_help())]
+pub struct Args {
+    /// Speed: `12km/h`, `3.3m/s`, `200m/min` (a bare number is m/s). Without it and without
+    /// --step-length/--step-freq: 12 km/h.
+    #[arg(long)]
+    pub speed: Option<String>,
+    /// Step length: `1.07m`, `107cm` (bare: m). Held fixed together with the other parameters
+    /// given; eq. 2 gives way.
+    #[arg(long = "step-length")]
+    pub step_length: Option<String>,
+    /// Step frequency: `187/min`, `3.1Hz` (bare: steps/min).
+    #[arg(long = "step-freq")]
+    pub step_freq: Option<String>,
+    /// Flight height H (eq. 3): `0.004m`, `4mm` (bare: m). The flight time then follows from H.
+    #[arg(long = "flight-height")]
+    pub flight_height: Option<String>,
+    /// Expertise level, −1 (poor) … 1 (skilled) (scaled to the paper's ±0.001 in eq. 2 and
+    /// ±0.0001 in eqs. 4–5).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub level: f64,
+    /// Body height: `1.8`, `180cm`.
+    #[arg(long, default_value = "1.8")]
+    pub height: String,
+    /// An attribute, `name=value` in its unit (degrees, metres, factor; `strike=heel|toe`);
+    /// repeatable; see the list below.
+    #[arg(long = "attr", value_name = "NAME=VALUE")]
+    pub attrs: Vec<String>,
+    /// Keep these parameters locked during a schedule (comma-separated: speed, step-length,
+    /// step-freq, flight-height).
+    #[arg(long, value_delimiter = ',')]
+    pub lock: Vec<String>,
+    /// Per-step schedule CSV (`step`, `speed_km_per_h`|`speed_m_per_s`, `step_length_m`,
+    /// `step_freq_steps_per_min`, `flight_height_m`, `level`, `action` = run|stop).
+    #[arg(long)]
+    pub schedule: Option<PathBuf>,
+    /// Folder with refitted relations (`run-sl-v.json`, `run-tflight-sf.json`); the published
+    /// coefficients otherwise.
+    #[arg(long)]
+    pub fits: Option<PathBuf>,
+    /// Duration, s.
+    #[arg(long, default_value_t = 10.0)]
+    pub seconds: f64,
+    /// Frames per second of the output.
+    #[arg(long, default_value_t = 120.0)]
+    pub fps: f64,
+    /// Do not stop at the end (by default the run ends standing by --seconds).
+    #[arg(long = "no-stop")]
+    pub no_stop: bool,
+    /// Also write one row per generated step (side, start, speed, step length, frequency,
+    /// flight time and height, pelvis at toe off and heel strike, recoveries) to this CSV.
+    #[arg(long = "steps")]
+    pub steps_csv: Option<PathBuf>,
+    /// Output file: `.bvh`, `.csv` (plus `<stem>_events.csv`) or `.trc`.
+    #[arg(short = 'o', long)]
+    pub output: PathBuf,
+}
+
+fn attribute_help() -> String {
+    let mut s = String::from("Running attributes (--attr name=value; couplings act on top of the setting):\n");
+    for a in SPECS.iter() {
+        let shown = |v: f64| {
+            if a.unit == AttrUnit::Degrees {
+                v.to_degrees()
+            } else {
+                v
+            }
+        };
+        s += &format!(
+            "  {:22} default {:>6.3} {:7} range [{}, {}]  {}\n",
+            a.name,
+            shown(a.default),
+            unit_name(a.unit),
+            shown(a.min),
+            shown(a.max),
+            a.doc
+        );
+    }
+    s += "Lengths are for a 1.8 m figure and scale with --height.\n";
+    s
+}
+
+fn param_of(name: &str) -> anyhow::Result<Param> {
+    Ok(match name.trim() {
+        "speed" | "v" => Param::Speed,
+        "step-length" | "step_length" | "sl" => Param::StepLength,
+        "step-freq" | "step_freq" | "sf" => Param::StepFreq,
+        "flight-height" | "flight_height" | "h" | "H" => Param::FlightHeight,
+        other => bail!("--lock {other:?}: use speed, step-length, step-freq or flight-height"),
+    })
+}
+
+fn value(flag: &str, text: &str, dim: Dimension) -> anyhow::Result<f64> {
+    parse_value(text, dim).map_err(|e| anyhow::anyhow!("{flag} {e}"))
+}
 
 /// Runs `gaitfit generate run`.
-pub fn run(_args: &Args) -> anyhow::Result<ExitCode> {
-    anyhow::bail!("gaitfit generate run: not implemented yet")
+pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
+    let height = value("--height", &args.height, Dimension::Length)?;
+    let skeleton = Skeleton::from_height(height, default_mass(height))
+        .with_context(|| format!("--height {}", args.height))?;
+    let relations = match &args.fits {
+        Some(dir) => RunRelations::from_fits(dir)?,
+        None => RunRelations::published(),
+    };
+    let model = RunModel::new(skeleton, relations)?;
+    let mut attrs = RunAttributes::defaults(height);
+    for a in &args.attrs {
+        let (name, val) = a
+            .split_once('=')
+            .with_context(|| format!("--attr {a:?}: expected name=value"))?;
+        let attr = Attr::from_name(name).with_context(|| {
+            format!("--attr {name:?}: unknown attribute; `gaitfit generate run --help` lists them")
+        })?;
+        let v = match attr.spec().unit {
+            AttrUnit::Degrees => value("--attr", val, Dimension::Angle)?,
+            AttrUnit::Metres => value("--attr", val, Dimension::Length)?,
+            AttrUnit::Switch => match val.trim() {
+                "heel" | "0" => 0.0,
+                "toe" | "1" => 1.0,
+                other => bail!("--attr strike={other:?}: use heel or toe"),
+            },
+            AttrUnit::Factor => val
+                .trim()
+                .parse::<f64>()
+                .with_context(|| format!("--attr {a:?}: not a number"))?,
+        };
+        attrs.set(attr, v)?;
+    }
+    // Parameters: start natural at the given speed (or 12 km/h), then fix each parameter given,
+    // holding the earlier ones (as one schedule row does).
+    let mut given: Vec<(Param, f64)> = Vec::new();
+    if let Some(s) = &args.speed {
+        given.push((Param::Speed, value("--speed", s, Dimension::Speed)?));
+    }
+    if let Some(s) = &args.step_length {
+        given.push((Param::StepLength, value("--step-length", s, Dimension::Length)?));
+    }
+    if let Some(s) = &args.step_freq {
+        given.push((Param::StepFreq, value("--step-freq", s, Dimension::Frequency)?));
+    }
+    if let Some(s) = &args.flight_height {
+        given.push((Param::FlightHeight, value("--flight-height", s, Dimension::Length)?));
+    }
+    let start_v = given
+        .iter()
+        .find(|(p, _)| *p == Param::Speed)
+        .map(|g| g.1)
+        .unwrap_or(12.0 / 3.6);
+    let mut params = model.natural(start_v, args.level, &attrs)?;
+    for &(p, v) in &given {
+        params = model.set(&params, p, v, &attrs)?;
+        params.locks.set(p, true);
+    }
+    params.locks = Default::default();
+    for l in &args.lock {
+        params.locks.set(param_of(l)?, true);
+    }
+    let schedule = match &args.schedule {
+        Some(p) => Some(Schedule::from_csv(p)?),
+        None => None,
+    };
+    let opts = GenerateOptions {
+        seconds: args.seconds,
+        fps: args.fps,
+        stop_at_end: !args.no_stop,
+    };
+    let (motion, report) = generate_run(&model, params, attrs, schedule, &opts)?;
+    crate::export::motion::write(&motion, &args.output)?;
+    if let Some(path) = &args.steps_csv {
+        write_steps(path, &report)?;
+    }
+    println!(
+        "gaitfit generate run: {} frames at {} fps ({:.2} s), {} steps, relations {}",
+        motion.len(),
+        motion.fps(),
+        motion.duration_s(),
+        report.steps.len(),
+        report.relations
+    );
+    println!(
+        "  start: v {:.3} m/s ({:.1} km/h), sl {:.3} m, sf {:.1} steps/min, t_flight {:.3} s, H {:.4} m, level {}",
+        params.speed,
+        params.speed * 3.6,
+        params.step_length,
+        params.step_freq * 60.0,
+        params.flight_time,
+        params.flight_height,
+        params.level
+    );
+    for n in &report.notes {
+        println!("  note: {n}");
+    }
+    println!("  wrote {}", args.output.display());
+    Ok(ExitCode::SUCCESS)
+}
+
+fn write_steps(path: &std::path::Path, report: &crate::generator::running::RunReport) -> anyhow::Result<()> {
+    let mut out = String::from(
+        "step,side,kind,start_s,duration_s,speed_m_per_s,step_length_m,step_freq_steps_per_min,\
+         stance_time_s,flight_time_s,flight_height_m,case,x1_m,y1_m,x2_m,y2_m,p,mid_support_lowered,clearance_raises\n",
+    );
+    for s in &report.steps {
+        let r = &s.report;
+        out += &format!(
+            "{},{},{:?},{:.6},{:.6},{:.6},{:.6},{:.4},{:.6},{:.6},{:.6},{},{:.6},{:.6},{:.6},{:.6},{:.4},{},{}\n",
+            s.index,
+            s.side,
+            s.kind,
+            s.start_s,
+            s.duration_s,
+            s.speed,
+            s.step_length,
+            s.step_freq * 60.0,
+            r.t_stance,
+            r.t_flight,
+            r.flight_height,
+            match r.case {
+                Some(crate::generator::running::state::FlightCase::I) => "I",
+                Some(crate::generator::running::state::FlightCase::II) => "II",
+                None => "",
+            },
+            r.p1.x,
+            r.p1.y,
+            r.p2.x,
+            r.p2.y,
+            r.p,
+            r.mid_support_lowered,
+            r.clearance_keys
+        );
+    }
+    crate::fsio::write_atomic_bytes(path, out.as_bytes())
+        .with_context(|| format!("writing {}", path.display()))?;
+    Ok(())
 }

@@ -58,23 +58,22 @@ pub fn pelvis_at(plan: &StepPlan, t: f64) -> (DVec3, DVec3) {
     (p, v)
 }
 
-/// Pelvic rotation (yaw) and list (roll) at `t`: linear between the keyframes of Fig. 7.
+/// Pelvic rotation (yaw) and list (roll) at `t`: cubic Hermite through the keyframes of Fig. 7
+/// (see [`StepPlan::orient_rate`]).
 #[inline]
 pub fn orient_at(plan: &StepPlan, t: f64) -> (f64, f64) {
     let k = &plan.orient;
+    let r = &plan.orient_rate;
     let n = plan.norient;
     if t <= k[0].0 {
         return (k[0].1, k[0].2);
     }
     for i in 0..n - 1 {
-        let (a, b) = (k[i], k[i + 1]);
-        if t <= b.0 || i + 2 == n {
-            let s = if b.0 > a.0 {
-                ((t - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
-            return (a.1 + s * (b.1 - a.1), a.2 + s * (b.2 - a.2));
+        if t <= k[i + 1].0 || i + 2 == n {
+            let (a, b) = (k[i], k[i + 1]);
+            let (y, _) = hermite(a.0, b.0, a.1, b.1, r[i].0, r[i + 1].0, t);
+            let (l, _) = hermite(a.0, b.0, a.2, b.2, r[i].1, r[i + 1].1, t);
+            return (y, l);
         }
     }
     (k[n - 1].1, k[n - 1].2)
@@ -129,6 +128,18 @@ pub fn circle_sphere(toe: DVec2, r_toe: f64, hip: DVec2, r_hip: f64) -> Option<D
 
 /// The stance leg at step time `t` (0 ≤ t ≤ t_stance, or the whole stop phase), given the hip.
 pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> StanceEval {
+    stance_leg_in(plan, d, t, hip, None)
+}
+
+/// As [`stance_leg`], with the heel-off sub-mode forced to `heel_off_mode` (HeelOff or
+/// HeelOffKneeRaised) when given: rates are taken within one mode, not across a switch.
+pub fn stance_leg_in(
+    plan: &StepPlan,
+    d: &RunnerDims,
+    t: f64,
+    hip: DVec3,
+    heel_off_mode: Option<StanceMode>,
+) -> StanceEval {
     let fp = &plan.stance_print;
     let z = fp.heel.z;
     let flat_ankle = fp.heel + DVec3::new(d.heel_back, d.ankle_height, 0.0);
@@ -180,12 +191,14 @@ pub fn stance_leg(plan: &StepPlan, d: &RunnerDims, t: f64, hip: DVec3) -> Stance
     let dd = d.hip_ankle(k);
     let r_hip = (dd * dd - dz * dz).max(0.0).sqrt();
     let hip2 = DVec2::new(hip.x, hip.y);
-    if let Some(a) = circle_sphere(toe, r_toe, hip2, r_hip) {
+    let allow_circle = heel_off_mode != Some(StanceMode::HeelOffKneeRaised);
+    let force_circle = heel_off_mode == Some(StanceMode::HeelOff);
+    if let Some(a) = circle_sphere(toe, r_toe, hip2, r_hip).filter(|_| allow_circle) {
         let to_toe = toe - a;
         let pitch = to_toe.y.atan2(to_toe.x) - tf.y.atan2(tf.x);
         let ball_y = a.y + rot2(pitch, d.ball_f(m)).y;
         let heel_y = a.y + rot2(pitch, d.heel_f()).y;
-        if ball_y >= -1e-9 && heel_y >= -1e-9 {
+        if force_circle || (ball_y >= -1e-9 && heel_y >= -1e-9) {
             return finish(DVec3::new(a.x, a.y, z), pitch, m, StanceMode::HeelOff);
         }
     }

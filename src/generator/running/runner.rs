@@ -62,6 +62,12 @@ pub const STOP_SPEED: f64 = 1.5;
 /// Speed reduction per step while decelerating to a stop, m/s (at 1.8 m, Froude-scaled).
 pub const STOP_DECELERATION: f64 = 0.6;
 
+/// Speed of the first step from a stand, m/s at 1.8 m (Froude-scaled); faster runs build up to
+/// their speed by [`START_ACCELERATION`] per step.
+pub const START_SPEED: f64 = 2.5;
+/// Speed gained per step while starting, m/s at 1.8 m (Froude-scaled).
+pub const START_ACCELERATION: f64 = 0.8;
+
 /// How far the pelvis at least rises from the stand to the first toe off, m at 1.8 m.
 pub const START_RISE: f64 = 0.02;
 
@@ -72,6 +78,7 @@ pub struct Runner {
     params: RunParams,
     attrs: RunAttributes,
     pending: Option<(RunParams, RunAttributes)>,
+    ramp_target: Option<RunParams>,
     schedule: Option<Schedule>,
     stop_requested: bool,
     state: RunState,
@@ -110,6 +117,7 @@ impl Runner {
             params,
             attrs,
             pending: None,
+            ramp_target: None,
             schedule,
             stop_requested: false,
             state: RunState::Running,
@@ -121,6 +129,9 @@ impl Runner {
             events: Vec::new(),
         };
         r.apply_schedule()?;
+        if r.pending.is_none() {
+            r.ramp_target = Some(r.params);
+        }
         r.adapt_stand()?;
         r.plan_current(StepKind::Start)?;
         Ok(r)
@@ -240,10 +251,14 @@ impl Runner {
     /// From a stand the pelvis must rise to the first toe off (so the swing foot, starting on
     /// the ground, lifts off): crouch as needed below the first step's toe-off height.
     fn adapt_stand(&mut self) -> Result<(), GenerateError> {
-        let (params, attrs) = match &self.pending {
+        let (mut params, attrs) = match &self.pending {
             Some((p, a)) => (*p, a.clone()),
             None => (self.params, self.attrs.clone()),
         };
+        let v_start = START_SPEED * self.froude();
+        if params.speed > v_start {
+            params = self.model.natural(v_start, params.level, &attrs)?;
+        }
         let eff = attrs.effective(&params.drivers());
         let inp = StepInput {
             speed: params.speed,
@@ -265,6 +280,9 @@ impl Runner {
     fn next_speed(&self) -> f64 {
         if let Some((p, _)) = &self.pending {
             return p.speed;
+        }
+        if let Some(target) = &self.ramp_target {
+            return (self.params.speed + START_ACCELERATION * self.froude()).min(target.speed);
         }
         if let Some(s) = &self.schedule {
             for row in s.rows_at(self.step + 1) {
@@ -292,6 +310,28 @@ impl Runner {
         if let Some((p, a)) = self.pending.take() {
             self.params = p;
             self.attrs = a;
+            // New parameters replace whatever the start was ramping toward…
+            self.ramp_target = None;
+            if kind == StepKind::Start {
+                self.ramp_target = Some(self.params);
+            }
+        }
+        let fr = self.froude();
+        // …and a start from a stand accelerates step by step: the first step at most
+        // START_SPEED, then START_ACCELERATION more per step (p rises toward 0.9 meanwhile).
+        if let Some(target) = self.ramp_target {
+            let v = if kind == StepKind::Start {
+                START_SPEED * fr
+            } else {
+                self.params.speed + START_ACCELERATION * fr
+            };
+            if v >= target.speed - 1e-9 {
+                self.params = target;
+                self.ramp_target = None;
+            } else {
+                let level = target.level;
+                self.params = self.model.natural(v, level, &self.attrs)?;
+            }
         }
         let d = self.model.dims;
         if self.stop_requested && kind != StepKind::Start {

@@ -18,7 +18,7 @@ use nalgebra::{Matrix2, Vector2};
 use super::attributes::{Effective, Strike};
 use super::curves::{c2_mid_velocity, Key, KneeBump, Seg3, Track};
 use super::dims::{leg_fk, leg_ik, pelvis_matrix, pitch_from_down, rot2, LegAngles, RunnerDims};
-use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
+use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, stance_leg_in, StanceMode};
 use crate::generator::GenerateError;
 
 /// Gravitational acceleration used in eq. 3 and the flight parabola, m/s².
@@ -131,6 +131,10 @@ pub struct Carry {
     pub yaw: f64,
     /// Pelvic list, rad.
     pub roll: f64,
+    /// Pelvic rotation rate, rad/s.
+    pub yaw_rate: f64,
+    /// Pelvic list rate, rad/s.
+    pub roll_rate: f64,
     /// The landed foot.
     pub stance_print: Footprint,
     /// The other foot's last footprint.
@@ -262,6 +266,9 @@ pub struct StepPlan {
     pub flight_v: DVec3,
     /// Orientation keyframes (t, yaw, roll).
     pub orient: [(f64, f64, f64); 4],
+    /// Rotation and list rates at the keyframes (rad/s): the keyframes are joined by cubic
+    /// Hermite segments with Catmull–Rom rates, C1 across steps.
+    pub orient_rate: [(f64, f64); 4],
     /// Keyframes used.
     pub norient: usize,
     /// Stance foot.
@@ -445,6 +452,9 @@ pub const STOP_KNEE: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Longest stop phase, s at 1.8 m.
 pub const STOP_TIME: f64 = 0.6;
 
+/// Least downward speed of the landing foot's lowest point at heel strike, m/s at 1.8 m.
+pub const LANDING_SPEED: f64 = 0.15;
+
 /// Standing: knee flexion used for the initial and final stands, rad.
 pub const STAND_KNEE: f64 = 6.0 * std::f64::consts::PI / 180.0;
 
@@ -479,6 +489,8 @@ pub fn standing_carry(
         pelvis_vel: DVec3::ZERO,
         yaw: 0.0,
         roll: 0.0,
+        yaw_rate: 0.0,
+        roll_rate: 0.0,
         stance_print: stance,
         other_print: other,
         swing,
@@ -730,6 +742,17 @@ pub fn plan_step(
         (t_stance, yaw1, 0.0),
         (t_step, yaw2, roll2),
     ];
+    // Fig. 7's keyframes are joined smoothly (the paper interpolates linearly; its kinks at toe
+    // off would jerk the hips, and with them the feet, in short flights). The rate at the end
+    // heads for the next step's mid-support keyframe (no rotation, list to the other side).
+    let cr = |a: (f64, f64, f64), b: (f64, f64, f64)| ((b.1 - a.1) / (b.0 - a.0), (b.2 - a.2) / (b.0 - a.0));
+    let next_ms = (t_step + t_ms, 0.0, s * list_max);
+    let orient_rate = [
+        (carry.yaw_rate, carry.roll_rate),
+        cr(orient[0], orient[2]),
+        cr(orient[1], orient[3]),
+        cr(orient[2], next_ms),
+    ];
 
     let empty_track = Track::new();
     let mut plan = StepPlan {
@@ -746,6 +769,7 @@ pub fn plan_step(
         flight_p1: p1,
         flight_v,
         orient,
+        orient_rate,
         norient: 4,
         stance_print: fp,
         next_print,
@@ -931,6 +955,26 @@ pub fn plan_step(
     let mut hs_rate = LegAngles::default();
     for c in 0..5 {
         hs_rate.set(c, HS_RATE_MATCH * (hs_next.get(c) - hs.get(c)) / eps);
+    }
+    // The foot must come down onto the ground, not graze it: if the lowest sole point would
+    // arrive slower than LANDING_SPEED (slow runs land with almost no vertical pelvis speed),
+    // the knee extends a little faster at impact.
+    let lowest_before = |rate: &LegAngles| {
+        let mut a = hs;
+        for c in 0..5 {
+            a.set(c, hs.get(c) - eps * rate.get(c));
+        }
+        leg_fk(d, hip2 - v_land * eps, &a).lowest()
+    };
+    let vy = -lowest_before(&hs_rate) / eps;
+    let need = -LANDING_SPEED * (d.body_height / 1.8).sqrt();
+    if vy > need {
+        let mut bent = hs;
+        bent.knee += eps;
+        let dk = (leg_fk(d, hip2, &bent).lowest() - leg_fk(d, hip2, &hs).lowest()) / eps;
+        if dk.abs() > 1e-3 {
+            hs_rate.knee += (need - vy) / dk;
+        }
     }
     if kind != StepKind::Start {
         let rate = LegAngles {
@@ -1133,7 +1177,11 @@ fn stance_state(plan: &StepPlan, d: &RunnerDims, t: f64) -> (LegAngles, LegAngle
     let hip = hip_of(plan, d, t, plan.s);
     let now = stance_leg(plan, d, t, hip);
     let hip_b = hip_of(plan, d, t - e, plan.s);
-    let before = stance_leg(plan, d, t - e, hip_b);
+    let mode = match now.mode {
+        StanceMode::HeelOff | StanceMode::HeelOffKneeRaised => Some(now.mode),
+        _ => None,
+    };
+    let before = stance_leg_in(plan, d, t - e, hip_b, mode);
     let mut rate = LegAngles::default();
     for c in 0..5 {
         rate.set(c, (now.angles.get(c) - before.angles.get(c)) / e);
@@ -1166,9 +1214,9 @@ fn clear_track(
             let t = t_a + (t_b - t_a) * i as f64 / n as f64;
             let (ang, _) = track.eval(t);
             let pts = leg_fk(d, hip_of(plan, d, t, sign), &ang);
-            // Half a millimetre of slack: the generator's own penetration bound is 1 mm.
-            let deficit =
-                required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.0005;
+            // A twentieth of a millimetre of slack (numerical noise), so the foot is strictly off
+            // the ground wherever the requirement is positive.
+            let deficit = required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.00005;
             if deficit > worst.0 {
                 worst = (deficit, t);
             }
@@ -1223,6 +1271,8 @@ pub fn carry_out(plan: &StepPlan, d: &RunnerDims) -> Carry {
         pelvis_vel,
         yaw,
         roll,
+        yaw_rate: plan.orient_rate[3].0,
+        roll_rate: plan.orient_rate[3].1,
         stance_print: plan.next_print,
         other_print: plan.stance_print,
         swing,
@@ -1321,6 +1371,7 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
             (t_stop, 0.0, 0.0),
             (t_stop, 0.0, 0.0),
         ],
+        orient_rate: [(carry.yaw_rate, carry.roll_rate), (0.0, 0.0), (0.0, 0.0), (0.0, 0.0)],
         norient: 3,
         stance_print: fp,
         next_print: final_print,

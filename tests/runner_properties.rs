@@ -1,0 +1,256 @@
+//! Property tests of the running generator over the paper's range (2–25 km/h) and body heights
+//! 1.5–2.0 m: steady state reaches the commanded v, sl, sf (1 %), t_flight and H within one
+//! frame of eqs. 3–5; both feet are off the ground exactly during flight; no stance-foot sliding
+//! (≤ 2 mm), no ground penetration (≤ 1 mm); the swing foot clears the ground; joints and
+//! landmarks are continuous; left and right are mirror images one step apart. Modest case
+//! counts keep CI fast (each case generates a few seconds of motion in milliseconds).
+use gaitfit::events::{EventKind, Side};
+use gaitfit::generator::checks::{
+    contact_on_ground, flight_timing, ground_penetration, stance_sliding,
+    swing_clearance, symmetry, ContinuityOptions,
+};
+use gaitfit::generator::motion::{Motion, MotionMetadata};
+use gaitfit::generator::running::state::G;
+use gaitfit::generator::running::{
+    generate_run, GenerateOptions, RunAttributes, RunModel, RunParams, RunReport, Runner,
+};
+use gaitfit::generator::skeleton::{mirror_vec, side_index, Joint, Landmark};
+use proptest::prelude::*;
+
+const FPS: f64 = 120.0;
+
+fn run(kmh: f64, h: f64, seconds: f64, stop: bool) -> (Motion, RunReport, RunParams) {
+    let m = RunModel::published(h).unwrap();
+    let a = RunAttributes::defaults(h);
+    let p = m.natural(kmh / 3.6, 0.0, &a).unwrap();
+    let opts = GenerateOptions { seconds, fps: FPS, stop_at_end: stop };
+    let (mo, rep) = generate_run(&m, p, a, None, &opts).unwrap();
+    (mo, rep, p)
+}
+
+/// Frames [a, b) of a motion as a motion of their own (for checks on the steady part).
+fn sub(m: &Motion, a: usize, b: usize) -> Motion {
+    let mut o = Motion::new(m.skeleton().clone(), m.fps(), MotionMetadata::default()).unwrap();
+    for i in a..b.min(m.len()) {
+        o.push_frame(*m.pose(i), m.contacts()[i]);
+    }
+    o
+}
+
+/// The continuity measure of `gaitfit::generator::checks::continuity` (each frame-to-frame step
+/// of every landmark and joint rotation against the median of the `window` steps on either
+/// side, with the same floors), evaluated where the window is complete on both sides: at a
+/// clip's very end the window is one-sided, and a joint that starts moving in the last frames
+/// (a run cut just after a toe off) would be compared with nothing but the rest before it.
+fn interior_continuity(m: &Motion, o: &ContinuityOptions) -> (f64, String) {
+    let w = o.window;
+    let n = m.len();
+    let mut worst = (0.0, String::new());
+    let mut scan = |steps: &[f64], floor: f64, name: &str| {
+        for i in w..steps.len().saturating_sub(w) {
+            let mut nb: Vec<f64> = steps[i - w..i].iter().chain(steps[i + 1..=i + w].iter()).copied().collect();
+            nb.sort_by(f64::total_cmp);
+            let med = 0.5 * (nb[w - 1] + nb[w]);
+            let r = steps[i] / med.max(floor);
+            if r > worst.0 {
+                worst = (r, format!("frame {i}, {name}"));
+            }
+        }
+    };
+    for l in Landmark::ALL {
+        let s: Vec<f64> = (0..n - 1).map(|i| (m.landmark(i + 1, l) - m.landmark(i, l)).length()).collect();
+        scan(&s, o.floor_m, l.name());
+    }
+    for j in Joint::ALL {
+        let s: Vec<f64> = (0..n - 1)
+            .map(|i| {
+                let r = m.pose(i).rotations[j.index()].conjugate() * m.pose(i + 1).rotations[j.index()];
+                2.0 * r.xyz().length().atan2(r.w.abs())
+            })
+            .collect();
+        scan(&s, o.floor_rad, j.name());
+    }
+    worst
+}
+
+/// Heel strikes from the contact flags: (frame of the rising edge, side).
+fn touchdowns(m: &Motion) -> Vec<(usize, Side)> {
+    let c = m.contacts();
+    let mut out = Vec::new();
+    for i in 1..c.len() {
+        for side in [Side::Left, Side::Right] {
+            let k = side_index(side);
+            if c[i][k] && !c[i - 1][k] {
+                out.push((i, side));
+            }
+        }
+    }
+    out.sort_by_key(|t| t.0);
+    out
+}
+
+/// The footprint (heel on the ground) of the contact run starting at frame `f`.
+fn footprint_x(m: &Motion, f: usize, side: Side) -> f64 {
+    let heel = Landmark::foot(side)[0];
+    let mut best = (f64::INFINITY, 0.0);
+    let mut i = f;
+    while i < m.len() && m.contact(i, side) {
+        let p = m.landmark(i, heel);
+        if p.y < best.0 {
+            best = (p.y, p.x);
+        }
+        i += 1;
+    }
+    best.1
+}
+
+fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
+    // Long enough for the start, the speed build-up and ten steady steps.
+    let sf = {
+        let m = RunModel::published(h).unwrap();
+        m.natural(kmh / 3.6, 0.0, &RunAttributes::defaults(h)).unwrap().step_freq
+    };
+    let (mo, rep, p) = run(kmh, h, 1.0 + 20.0 / sf, false);
+    let dt = 1.0 / FPS;
+    // Whole motion, start from a stand included.
+    for r in [
+        stance_sliding(&mo, 0.002, 0.002),
+        ground_penetration(&mo, 0.001),
+        contact_on_ground(&mo, 0.001),
+        swing_clearance(&mo, 0.5, 0.005),
+    ] {
+        prop_assert!(r.passed, "{kmh:.2} km/h, h {h:.2} m: {r}");
+    }
+    let (ratio, at) = interior_continuity(&mo, &ContinuityOptions::default());
+    prop_assert!(ratio <= 5.0, "{kmh:.2} km/h, h {h:.2} m: continuity ratio {ratio:.2} at {at}");
+    // Both feet off the ground exactly during flight: every frame with both contact flags clear
+    // has all six sole points strictly above the ground; in contact, the foot touches (checked
+    // above by contact_on_ground).
+    for i in 0..mo.len() {
+        if mo.contacts()[i] == [false, false] {
+            for side in [Side::Left, Side::Right] {
+                for l in Landmark::foot(side) {
+                    let y = mo.landmark(i, l).y;
+                    prop_assert!(y > 0.0, "{kmh:.2} km/h: frame {i} in flight, {} at {y}", l.name());
+                }
+            }
+        }
+    }
+    // Steady state: from the second touchdown after the last step that was still building up
+    // speed from the stand (the runner accelerates from a stand step by step).
+    let td = touchdowns(&mo);
+    let ramp = rep.steps.iter().filter(|s| (s.speed - p.speed).abs() > 1e-9).count();
+    prop_assert!(td.len() >= ramp + 8, "{} touchdowns, {ramp} ramp steps", td.len());
+    let steady = &td[ramp + 1..];
+    let n = steady.len() - 1;
+    // Step length: successive footprints.
+    for w in steady.windows(2) {
+        let sl = footprint_x(&mo, w[1].0, w[1].1) - footprint_x(&mo, w[0].0, w[0].1);
+        prop_assert!((sl / p.step_length - 1.0).abs() < 0.01, "{kmh:.2} km/h: sl {sl} vs {}", p.step_length);
+    }
+    // Step frequency: touchdown frames over n steps (one-frame resolution over n steps).
+    let span = (steady[n].0 - steady[0].0) as f64 * dt;
+    let sf = n as f64 / span;
+    prop_assert!((sf / p.step_freq - 1.0).abs() < 0.01, "{kmh:.2} km/h: sf {sf} vs {}", p.step_freq);
+    // Speed: pelvis displacement over whole strides.
+    let k = if n % 2 == 0 { n } else { n - 1 };
+    let (fa, fb) = (steady[0].0, steady[k].0);
+    let v = (mo.landmark(fb, Landmark::Pelvis).x - mo.landmark(fa, Landmark::Pelvis).x) / ((fb - fa) as f64 * dt);
+    prop_assert!((v / p.speed - 1.0).abs() < 0.01, "{kmh:.2} km/h: v {v} vs {}", p.speed);
+    // Flight time within one frame of eqs. 4–5 (frames with both feet off the ground).
+    let st = sub(&mo, steady[0].0, steady[n].0);
+    let ft = flight_timing(&st, p.flight_time, dt);
+    prop_assert!(ft.passed && ft.examined >= 3, "{kmh:.2} km/h: {ft}");
+    // Flight height within one frame of eq. 3: apex of the pelvis over each flight minus its
+    // height at toe off (interpolated at the exact generated toe-off time).
+    let pel = |t: f64| {
+        let f = (t * FPS).floor() as usize;
+        let u = t * FPS - f as f64;
+        mo.landmark(f, Landmark::Pelvis).y * (1.0 - u) + mo.landmark(f + 1, Landmark::Pelvis).y * u
+    };
+    let t0 = steady[0].0 as f64 * dt;
+    for e in mo.events.iter().filter(|e| e.kind == EventKind::ToeOff && e.time_s > t0 && e.time_s + p.flight_time < mo.duration_s()) {
+        let (a, b) = ((e.time_s * FPS).ceil() as usize, ((e.time_s + p.flight_time) * FPS).floor() as usize);
+        let apex = (a..=b).map(|i| mo.landmark(i, Landmark::Pelvis).y).fold(f64::NEG_INFINITY, f64::max);
+        let measured = (apex - pel(e.time_s)).max(0.0);
+        let w = (2.0 * G * p.flight_height).sqrt();
+        let one_frame = w * dt + G * dt * dt;
+        let expected = if rep.steps[ramp + 1].report.takeoff_vy > 0.0 { p.flight_height } else { 0.0 };
+        prop_assert!((measured - expected).abs() <= one_frame, "{kmh:.2} km/h: H {measured} vs {expected} (one frame {one_frame})");
+    }
+    // Left/right symmetry at constant parameters: one step later the figure is its own mirror.
+    // On the frames (the check interpolates between frames at t + one step, which for a foot
+    // swinging at up to 10 m/s errs by up to about a centimetre at 120 fps)…
+    let sym = symmetry(&st, 0..st.len(), 1.0 / p.step_freq, 0.02, 0.05);
+    prop_assert!(sym.landmarks.passed && sym.joints.passed, "{kmh:.2} km/h: {} / {}", sym.landmarks, sym.joints);
+    // …and exactly, by sampling the generator itself at t and t + one step.
+    let m = RunModel::published(h).unwrap();
+    let a = RunAttributes::defaults(h);
+    let sk = m.skeleton.clone();
+    let mut r0 = Runner::new(m.clone(), p, a.clone(), None).unwrap();
+    let mut r1 = Runner::new(m, p, a, None).unwrap();
+    let (mut q0, mut q1) = (sk.rest_pose(), sk.rest_pose());
+    let step = 1.0 / p.step_freq;
+    let t_start = steady[0].0 as f64 * dt;
+    for i in 0..40 {
+        let t = t_start + i as f64 * step / 13.0;
+        r0.pose_at(t, &mut q0).unwrap();
+        r1.pose_at(t + step, &mut q1).unwrap();
+        let (l0, l1) = (sk.landmarks(&q0), sk.landmarks(&q1));
+        let (p0, p1) = (l0[Landmark::Pelvis.index()], l1[Landmark::Pelvis.index()]);
+        for l in Landmark::ALL {
+            let a = mirror_vec(l0[l.index()] - p0);
+            let b = l1[l.mirrored().index()] - p1;
+            prop_assert!((a - b).length() < 1e-6, "{kmh:.2} km/h: t {t:.4}: {} vs {} differ by {}", l.name(), l.mirrored().name(), (a - b).length());
+        }
+    }
+    Ok(())
+}
+
+proptest! {
+    // 32 cases in CI; `RUNNER_PROPTEST_CASES=1000` for a deeper search.
+    #![proptest_config(ProptestConfig {
+        cases: std::env::var("RUNNER_PROPTEST_CASES").ok().and_then(|c| c.parse().ok()).unwrap_or(32),
+        failure_persistence: None,
+        .. ProptestConfig::default()
+    })]
+    #[test]
+    fn steady_running_invariants(kmh in 2.0f64..25.0, h in 1.5f64..2.0) {
+        check_steady(kmh, h)?;
+    }
+}
+
+/// The extremes of the ranges, always checked.
+#[test]
+fn extremes() {
+    for (kmh, h) in [(2.0, 1.5), (2.0, 2.0), (25.0, 1.5), (25.0, 2.0), (12.0, 1.8)] {
+        check_steady(kmh, h).unwrap();
+    }
+}
+
+/// From a stand to a stand: the run ends standing still with both feet flat on the ground.
+#[test]
+fn start_and_stop_in_a_stand() {
+    for (kmh, h) in [(5.0, 1.7), (12.0, 1.8), (20.0, 1.9)] {
+        let (mo, _, _) = run(kmh, h, 5.0, true);
+        for r in [
+            stance_sliding(&mo, 0.002, 0.002),
+            ground_penetration(&mo, 0.001),
+            contact_on_ground(&mo, 0.001),
+        ] {
+            assert!(r.passed, "{kmh} km/h: {r}");
+        }
+        let (ratio, at) = interior_continuity(&mo, &ContinuityOptions::default());
+        assert!(ratio <= 5.0, "{kmh} km/h: continuity ratio {ratio:.2} at {at}");
+        let last = mo.len() - 1;
+        assert_eq!(mo.contacts()[0], [true, true], "starts standing");
+        assert_eq!(mo.contacts()[last], [true, true], "ends standing");
+        let moved = (mo.landmark(last, Landmark::Pelvis) - mo.landmark(last - 12, Landmark::Pelvis)).length();
+        assert!(moved < 1e-9, "{kmh} km/h: still {moved} m in the last 0.1 s");
+        for side in [Side::Left, Side::Right] {
+            for l in Landmark::foot(side) {
+                assert!(mo.landmark(last, l).y.abs() < 1e-6, "{kmh} km/h: {} not on the ground", l.name());
+            }
+        }
+    }
+}
