@@ -6,13 +6,14 @@
 //! counts keep CI fast (each case generates a few seconds of motion in milliseconds).
 use gaitfit::events::{EventKind, Side};
 use gaitfit::generator::checks::{
-    contact_on_ground, flight_timing, ground_penetration, stance_sliding,
-    swing_clearance, symmetry, ContinuityOptions,
+    contact_on_ground, flight_timing, ground_penetration, stance_sliding, swing_clearance,
+    symmetry, ContinuityOptions,
 };
 use gaitfit::generator::motion::{Motion, MotionMetadata};
 use gaitfit::generator::running::state::G;
 use gaitfit::generator::running::{
-    generate_run, GenerateOptions, RunAttributes, RunModel, RunParams, RunReport, Runner,
+    generate_run, GenerateOptions, Param, RunAttributes, RunModel, RunParams, RunReport, Runner,
+    Schedule,
 };
 use gaitfit::generator::skeleton::{mirror_vec, side_index, Joint, Landmark};
 use proptest::prelude::*;
@@ -23,9 +24,41 @@ fn run(kmh: f64, h: f64, seconds: f64, stop: bool) -> (Motion, RunReport, RunPar
     let m = RunModel::published(h).unwrap();
     let a = RunAttributes::defaults(h);
     let p = m.natural(kmh / 3.6, 0.0, &a).unwrap();
-    let opts = GenerateOptions { seconds, fps: FPS, stop_at_end: stop };
-    let (mo, rep) = generate_run(&m, p, a, None, &opts).unwrap();
+    let (mo, rep) = run_params(h, p, None, seconds, stop);
     (mo, rep, p)
+}
+
+fn run_params(
+    h: f64,
+    p: RunParams,
+    schedule: Option<Schedule>,
+    seconds: f64,
+    stop: bool,
+) -> (Motion, RunReport) {
+    let m = RunModel::published(h).unwrap();
+    let a = RunAttributes::defaults(h);
+    let opts = GenerateOptions {
+        seconds,
+        fps: FPS,
+        stop_at_end: stop,
+    };
+    generate_run(&m, p, a, schedule, &opts).unwrap()
+}
+
+/// The ground checks every generated motion must pass (the whole motion: start from a stand,
+/// build-up, changes and stop included).
+fn ground_checks(mo: &Motion, what: &str) -> Result<(), TestCaseError> {
+    for r in [
+        stance_sliding(mo, 0.002, 0.002),
+        ground_penetration(mo, 0.001),
+        contact_on_ground(mo, 0.001),
+        swing_clearance(mo, 0.5, 0.005),
+    ] {
+        prop_assert!(r.passed, "{what}: {r}");
+    }
+    let (ratio, at) = interior_continuity(mo, &ContinuityOptions::default());
+    prop_assert!(ratio <= 5.0, "{what}: continuity ratio {ratio:.2} at {at}");
+    Ok(())
 }
 
 /// Frames [a, b) of a motion as a motion of their own (for checks on the steady part).
@@ -48,7 +81,11 @@ fn interior_continuity(m: &Motion, o: &ContinuityOptions) -> (f64, String) {
     let mut worst = (0.0, String::new());
     let mut scan = |steps: &[f64], floor: f64, name: &str| {
         for i in w..steps.len().saturating_sub(w) {
-            let mut nb: Vec<f64> = steps[i - w..i].iter().chain(steps[i + 1..=i + w].iter()).copied().collect();
+            let mut nb: Vec<f64> = steps[i - w..i]
+                .iter()
+                .chain(steps[i + 1..=i + w].iter())
+                .copied()
+                .collect();
             nb.sort_by(f64::total_cmp);
             let med = 0.5 * (nb[w - 1] + nb[w]);
             let r = steps[i] / med.max(floor);
@@ -58,13 +95,16 @@ fn interior_continuity(m: &Motion, o: &ContinuityOptions) -> (f64, String) {
         }
     };
     for l in Landmark::ALL {
-        let s: Vec<f64> = (0..n - 1).map(|i| (m.landmark(i + 1, l) - m.landmark(i, l)).length()).collect();
+        let s: Vec<f64> = (0..n - 1)
+            .map(|i| (m.landmark(i + 1, l) - m.landmark(i, l)).length())
+            .collect();
         scan(&s, o.floor_m, l.name());
     }
     for j in Joint::ALL {
         let s: Vec<f64> = (0..n - 1)
             .map(|i| {
-                let r = m.pose(i).rotations[j.index()].conjugate() * m.pose(i + 1).rotations[j.index()];
+                let r =
+                    m.pose(i).rotations[j.index()].conjugate() * m.pose(i + 1).rotations[j.index()];
                 2.0 * r.xyz().length().atan2(r.w.abs())
             })
             .collect();
@@ -105,33 +145,51 @@ fn footprint_x(m: &Motion, f: usize, side: Side) -> f64 {
 }
 
 fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
+    let m = RunModel::published(h).unwrap();
+    let p = m
+        .natural(kmh / 3.6, 0.0, &RunAttributes::defaults(h))
+        .unwrap();
+    check_steady_params(h, p)
+}
+
+/// Runs at `p` (from a stand, building up speed) and checks the steady state and the ground.
+fn check_steady_params(h: f64, p: RunParams) -> Result<(), TestCaseError> {
+    let kmh = p.speed * 3.6;
     // Long enough for the start, the speed build-up and ten steady steps.
-    let sf = {
-        let m = RunModel::published(h).unwrap();
-        m.natural(kmh / 3.6, 0.0, &RunAttributes::defaults(h)).unwrap().step_freq
-    };
-    let (mo, rep, p) = run(kmh, h, 1.0 + 20.0 / sf, false);
+    let (mo, rep) = run_params(h, p, None, 1.0 + 20.0 / p.step_freq, false);
     let dt = 1.0 / FPS;
-    // Whole motion, start from a stand included.
-    for r in [
-        stance_sliding(&mo, 0.002, 0.002),
-        ground_penetration(&mo, 0.001),
-        contact_on_ground(&mo, 0.001),
-        swing_clearance(&mo, 0.5, 0.005),
-    ] {
-        prop_assert!(r.passed, "{kmh:.2} km/h, h {h:.2} m: {r}");
-    }
-    let (ratio, at) = interior_continuity(&mo, &ContinuityOptions::default());
-    prop_assert!(ratio <= 5.0, "{kmh:.2} km/h, h {h:.2} m: continuity ratio {ratio:.2} at {at}");
+    ground_checks(
+        &mo,
+        &format!(
+            "{kmh:.2} km/h, sf {:.1}/min, h {h:.2} m",
+            p.step_freq * 60.0
+        ),
+    )?;
     // Both feet off the ground exactly during flight: every frame with both contact flags clear
     // has all six sole points strictly above the ground; in contact, the foot touches (checked
-    // above by contact_on_ground).
+    // above by contact_on_ground). The toe leaves the ground tangentially, so within a
+    // millisecond of a toe off (or heel strike) it may still sit on the ground to rounding (1 µm).
+    let near_event = |t: f64| {
+        mo.events.iter().any(|e| {
+            matches!(e.kind, EventKind::ToeOff | EventKind::HeelStrike)
+                && (e.time_s - t).abs() < 1e-3
+        })
+    };
     for i in 0..mo.len() {
         if mo.contacts()[i] == [false, false] {
+            let floor = if near_event(mo.frame_time(i)) {
+                -1e-6
+            } else {
+                0.0
+            };
             for side in [Side::Left, Side::Right] {
                 for l in Landmark::foot(side) {
                     let y = mo.landmark(i, l).y;
-                    prop_assert!(y > 0.0, "{kmh:.2} km/h: frame {i} in flight, {} at {y}", l.name());
+                    prop_assert!(
+                        y > floor,
+                        "{kmh:.2} km/h: frame {i} in flight, {} at {y}",
+                        l.name()
+                    );
                 }
             }
         }
@@ -139,24 +197,45 @@ fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
     // Steady state: from the second touchdown after the last step that was still building up
     // speed from the stand (the runner accelerates from a stand step by step).
     let td = touchdowns(&mo);
-    let ramp = rep.steps.iter().filter(|s| (s.speed - p.speed).abs() > 1e-9).count();
-    prop_assert!(td.len() >= ramp + 8, "{} touchdowns, {ramp} ramp steps", td.len());
+    let ramp = rep
+        .steps
+        .iter()
+        .filter(|s| (s.speed - p.speed).abs() > 1e-9)
+        .count();
+    prop_assert!(
+        td.len() >= ramp + 8,
+        "{} touchdowns, {ramp} ramp steps",
+        td.len()
+    );
     let steady = &td[ramp + 1..];
     let n = steady.len() - 1;
     // Step length: successive footprints.
     for w in steady.windows(2) {
         let sl = footprint_x(&mo, w[1].0, w[1].1) - footprint_x(&mo, w[0].0, w[0].1);
-        prop_assert!((sl / p.step_length - 1.0).abs() < 0.01, "{kmh:.2} km/h: sl {sl} vs {}", p.step_length);
+        prop_assert!(
+            (sl / p.step_length - 1.0).abs() < 0.01,
+            "{kmh:.2} km/h: sl {sl} vs {}",
+            p.step_length
+        );
     }
     // Step frequency: touchdown frames over n steps (one-frame resolution over n steps).
     let span = (steady[n].0 - steady[0].0) as f64 * dt;
     let sf = n as f64 / span;
-    prop_assert!((sf / p.step_freq - 1.0).abs() < 0.01, "{kmh:.2} km/h: sf {sf} vs {}", p.step_freq);
+    prop_assert!(
+        (sf / p.step_freq - 1.0).abs() < 0.01,
+        "{kmh:.2} km/h: sf {sf} vs {}",
+        p.step_freq
+    );
     // Speed: pelvis displacement over whole strides.
     let k = if n % 2 == 0 { n } else { n - 1 };
     let (fa, fb) = (steady[0].0, steady[k].0);
-    let v = (mo.landmark(fb, Landmark::Pelvis).x - mo.landmark(fa, Landmark::Pelvis).x) / ((fb - fa) as f64 * dt);
-    prop_assert!((v / p.speed - 1.0).abs() < 0.01, "{kmh:.2} km/h: v {v} vs {}", p.speed);
+    let v = (mo.landmark(fb, Landmark::Pelvis).x - mo.landmark(fa, Landmark::Pelvis).x)
+        / ((fb - fa) as f64 * dt);
+    prop_assert!(
+        (v / p.speed - 1.0).abs() < 0.01,
+        "{kmh:.2} km/h: v {v} vs {}",
+        p.speed
+    );
     // Flight time within one frame of eqs. 4–5 (frames with both feet off the ground).
     let st = sub(&mo, steady[0].0, steady[n].0);
     let ft = flight_timing(&st, p.flight_time, dt);
@@ -169,20 +248,48 @@ fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
         mo.landmark(f, Landmark::Pelvis).y * (1.0 - u) + mo.landmark(f + 1, Landmark::Pelvis).y * u
     };
     let t0 = steady[0].0 as f64 * dt;
-    for e in mo.events.iter().filter(|e| e.kind == EventKind::ToeOff && e.time_s > t0 && e.time_s + p.flight_time < mo.duration_s()) {
-        let (a, b) = ((e.time_s * FPS).ceil() as usize, ((e.time_s + p.flight_time) * FPS).floor() as usize);
-        let apex = (a..=b).map(|i| mo.landmark(i, Landmark::Pelvis).y).fold(f64::NEG_INFINITY, f64::max);
+    for e in mo.events.iter().filter(|e| {
+        e.kind == EventKind::ToeOff && e.time_s > t0 && e.time_s + p.flight_time < mo.duration_s()
+    }) {
+        let (a, b) = (
+            (e.time_s * FPS).ceil() as usize,
+            ((e.time_s + p.flight_time) * FPS).floor() as usize,
+        );
+        let apex = (a..=b)
+            .map(|i| mo.landmark(i, Landmark::Pelvis).y)
+            .fold(f64::NEG_INFINITY, f64::max);
         let measured = (apex - pel(e.time_s)).max(0.0);
-        let w = (2.0 * G * p.flight_height).sqrt();
+        // Eq. 3's H is the apex of the flight parabola above the toe-off height; when the pelvis
+        // lands much higher than it took off (long steps at a low frequency) the apex lies
+        // beyond the landing, and the highest point in flight is the landing instead.
+        let w = rep.steps[ramp + 1].report.takeoff_vy.max(0.0);
+        let t_f = p.flight_time;
+        prop_assert!(
+            w == 0.0 || (w * w / (2.0 * G) / p.flight_height - 1.0).abs() < 1e-6,
+            "{kmh:.2} km/h: take-off speed {w} vs H {}",
+            p.flight_height
+        );
         let one_frame = w * dt + G * dt * dt;
-        let expected = if rep.steps[ramp + 1].report.takeoff_vy > 0.0 { p.flight_height } else { 0.0 };
-        prop_assert!((measured - expected).abs() <= one_frame, "{kmh:.2} km/h: H {measured} vs {expected} (one frame {one_frame})");
+        let expected = if w / G <= t_f {
+            w * w / (2.0 * G)
+        } else {
+            w * t_f - 0.5 * G * t_f * t_f
+        };
+        prop_assert!(
+            (measured - expected).abs() <= one_frame,
+            "{kmh:.2} km/h: H {measured} vs {expected} (one frame {one_frame})"
+        );
     }
     // Left/right symmetry at constant parameters: one step later the figure is its own mirror.
     // On the frames (the check interpolates between frames at t + one step, which for a foot
     // swinging at up to 10 m/s errs by up to about a centimetre at 120 fps)…
     let sym = symmetry(&st, 0..st.len(), 1.0 / p.step_freq, 0.02, 0.05);
-    prop_assert!(sym.landmarks.passed && sym.joints.passed, "{kmh:.2} km/h: {} / {}", sym.landmarks, sym.joints);
+    prop_assert!(
+        sym.landmarks.passed && sym.joints.passed,
+        "{kmh:.2} km/h: {} / {}",
+        sym.landmarks,
+        sym.joints
+    );
     // …and exactly, by sampling the generator itself at t and t + one step.
     let m = RunModel::published(h).unwrap();
     let a = RunAttributes::defaults(h);
@@ -201,14 +308,20 @@ fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
         for l in Landmark::ALL {
             let a = mirror_vec(l0[l.index()] - p0);
             let b = l1[l.mirrored().index()] - p1;
-            prop_assert!((a - b).length() < 1e-6, "{kmh:.2} km/h: t {t:.4}: {} vs {} differ by {}", l.name(), l.mirrored().name(), (a - b).length());
+            prop_assert!(
+                (a - b).length() < 1e-6,
+                "{kmh:.2} km/h: t {t:.4}: {} vs {} differ by {}",
+                l.name(),
+                l.mirrored().name(),
+                (a - b).length()
+            );
         }
     }
     Ok(())
 }
 
 proptest! {
-    // 32 cases in CI; `RUNNER_PROPTEST_CASES=1000` for a deeper search.
+    // 32 cases each in CI; `RUNNER_PROPTEST_CASES=1000` for a deeper search.
     #![proptest_config(ProptestConfig {
         cases: std::env::var("RUNNER_PROPTEST_CASES").ok().and_then(|c| c.parse().ok()).unwrap_or(32),
         failure_persistence: None,
@@ -218,12 +331,53 @@ proptest! {
     fn steady_running_invariants(kmh in 2.0f64..25.0, h in 1.5f64..2.0) {
         check_steady(kmh, h)?;
     }
+
+    /// The paper's Fig. 4 manipulation over the range: speed locked, step frequency moved off
+    /// its natural value (step length gives way, eq. 1); the steady state reaches the new sl, sf.
+    #[test]
+    fn locked_speed_other_step_frequency(kmh in 6.0f64..25.0, h in 1.5f64..2.0, f in 0.9f64..1.1) {
+        let m = RunModel::published(h).unwrap();
+        let a = RunAttributes::defaults(h);
+        let mut p = m.natural(kmh / 3.6, 0.0, &a).unwrap();
+        p.locks.set(Param::Speed, true);
+        let p = m.set(&p, Param::StepFreq, p.step_freq * f, &a).unwrap();
+        prop_assert!((p.speed * 3.6 - kmh).abs() < 1e-9);
+        check_steady_params(h, p)?;
+    }
+
+    /// Parameter changes at the next step (a schedule changing speed twice, then a stop): the
+    /// ground checks and the continuity of every joint and landmark hold across the changes,
+    /// and the run ends standing.
+    #[test]
+    fn parameter_changes_are_continuous(
+        v1 in 2.0f64..25.0, v2 in 2.0f64..25.0, v3 in 2.0f64..25.0, h in 1.5f64..2.0,
+    ) {
+        let text = format!("step,speed_km_per_h,action\n0,{v1},run\n5,{v2},run\n9,{v3},run\n13,,stop\n");
+        let sched = Schedule::parse(&text, "proptest").unwrap();
+        let m = RunModel::published(h).unwrap();
+        let p = m.natural(v1 / 3.6, 0.0, &RunAttributes::defaults(h)).unwrap();
+        let (mo, rep) = run_params(h, p, Some(sched), 30.0, false);
+        let what = format!("{v1:.2} → {v2:.2} → {v3:.2} km/h, h {h:.2} m");
+        ground_checks(&mo, &what)?;
+        // The changes take effect at the scheduled steps.
+        let at = |i: usize| rep.steps.get(i).map(|s| s.speed * 3.6).unwrap_or(f64::NAN);
+        prop_assert!((at(5) - v2).abs() < 1e-6, "{what}: step 5 at {:.3} km/h", at(5));
+        prop_assert!((at(9) - v3).abs() < 1e-6, "{what}: step 9 at {:.3} km/h", at(9));
+        let last = mo.len() - 1;
+        prop_assert!(mo.contacts()[last] == [true, true], "{what}: does not end standing");
+    }
 }
 
 /// The extremes of the ranges, always checked.
 #[test]
 fn extremes() {
-    for (kmh, h) in [(2.0, 1.5), (2.0, 2.0), (25.0, 1.5), (25.0, 2.0), (12.0, 1.8)] {
+    for (kmh, h) in [
+        (2.0, 1.5),
+        (2.0, 2.0),
+        (25.0, 1.5),
+        (25.0, 2.0),
+        (12.0, 1.8),
+    ] {
         check_steady(kmh, h).unwrap();
     }
 }
@@ -241,15 +395,27 @@ fn start_and_stop_in_a_stand() {
             assert!(r.passed, "{kmh} km/h: {r}");
         }
         let (ratio, at) = interior_continuity(&mo, &ContinuityOptions::default());
-        assert!(ratio <= 5.0, "{kmh} km/h: continuity ratio {ratio:.2} at {at}");
+        assert!(
+            ratio <= 5.0,
+            "{kmh} km/h: continuity ratio {ratio:.2} at {at}"
+        );
         let last = mo.len() - 1;
         assert_eq!(mo.contacts()[0], [true, true], "starts standing");
         assert_eq!(mo.contacts()[last], [true, true], "ends standing");
-        let moved = (mo.landmark(last, Landmark::Pelvis) - mo.landmark(last - 12, Landmark::Pelvis)).length();
-        assert!(moved < 1e-9, "{kmh} km/h: still {moved} m in the last 0.1 s");
+        let moved = (mo.landmark(last, Landmark::Pelvis)
+            - mo.landmark(last - 12, Landmark::Pelvis))
+        .length();
+        assert!(
+            moved < 1e-9,
+            "{kmh} km/h: still {moved} m in the last 0.1 s"
+        );
         for side in [Side::Left, Side::Right] {
             for l in Landmark::foot(side) {
-                assert!(mo.landmark(last, l).y.abs() < 1e-6, "{kmh} km/h: {} not on the ground", l.name());
+                assert!(
+                    mo.landmark(last, l).y.abs() < 1e-6,
+                    "{kmh} km/h: {} not on the ground",
+                    l.name()
+                );
             }
         }
     }

@@ -74,7 +74,9 @@ pub struct Args {
 }
 
 fn attribute_help() -> String {
-    let mut s = String::from("Running attributes (--attr name=value; couplings act on top of the setting):\n");
+    let mut s = String::from(
+        "Running attributes (--attr name=value; couplings act on top of the setting):\n",
+    );
     for a in SPECS.iter() {
         let shown = |v: f64| {
             if a.unit == AttrUnit::Degrees {
@@ -151,13 +153,22 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         given.push((Param::Speed, value("--speed", s, Dimension::Speed)?));
     }
     if let Some(s) = &args.step_length {
-        given.push((Param::StepLength, value("--step-length", s, Dimension::Length)?));
+        given.push((
+            Param::StepLength,
+            value("--step-length", s, Dimension::Length)?,
+        ));
     }
     if let Some(s) = &args.step_freq {
-        given.push((Param::StepFreq, value("--step-freq", s, Dimension::Frequency)?));
+        given.push((
+            Param::StepFreq,
+            value("--step-freq", s, Dimension::Frequency)?,
+        ));
     }
     if let Some(s) = &args.flight_height {
-        given.push((Param::FlightHeight, value("--flight-height", s, Dimension::Length)?));
+        given.push((
+            Param::FlightHeight,
+            value("--flight-height", s, Dimension::Length)?,
+        ));
     }
     let start_v = given
         .iter()
@@ -212,7 +223,10 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_steps(path: &std::path::Path, report: &crate::generator::running::RunReport) -> anyhow::Result<()> {
+fn write_steps(
+    path: &std::path::Path,
+    report: &crate::generator::running::RunReport,
+) -> anyhow::Result<()> {
     let mut out = String::from(
         "step,side,kind,start_s,duration_s,speed_m_per_s,step_length_m,step_freq_steps_per_min,\
          stance_time_s,flight_time_s,flight_height_m,case,x1_m,y1_m,x2_m,y2_m,p,mid_support_lowered,clearance_raises\n",

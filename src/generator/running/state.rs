@@ -745,7 +745,9 @@ pub fn plan_step(
     // Fig. 7's keyframes are joined smoothly (the paper interpolates linearly; its kinks at toe
     // off would jerk the hips, and with them the feet, in short flights). The rate at the end
     // heads for the next step's mid-support keyframe (no rotation, list to the other side).
-    let cr = |a: (f64, f64, f64), b: (f64, f64, f64)| ((b.1 - a.1) / (b.0 - a.0), (b.2 - a.2) / (b.0 - a.0));
+    let cr = |a: (f64, f64, f64), b: (f64, f64, f64)| {
+        ((b.1 - a.1) / (b.0 - a.0), (b.2 - a.2) / (b.0 - a.0))
+    };
     let next_ms = (t_step + t_ms, 0.0, s * list_max);
     let orient_rate = [
         (carry.yaw_rate, carry.roll_rate),
@@ -1216,7 +1218,8 @@ fn clear_track(
             let pts = leg_fk(d, hip_of(plan, d, t, sign), &ang);
             // A twentieth of a millimetre of slack (numerical noise), so the foot is strictly off
             // the ground wherever the requirement is positive.
-            let deficit = required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.00005;
+            let deficit =
+                required_clearance(t, t_a, t_b, ramp_in, ramp_out, margin) - pts.lowest() - 0.00005;
             if deficit > worst.0 {
                 worst = (deficit, t);
             }
@@ -1371,7 +1374,12 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
             (t_stop, 0.0, 0.0),
             (t_stop, 0.0, 0.0),
         ],
-        orient_rate: [(carry.yaw_rate, carry.roll_rate), (0.0, 0.0), (0.0, 0.0), (0.0, 0.0)],
+        orient_rate: [
+            (carry.yaw_rate, carry.roll_rate),
+            (0.0, 0.0),
+            (0.0, 0.0),
+            (0.0, 0.0),
+        ],
         norient: 3,
         stance_print: fp,
         next_print: final_print,
