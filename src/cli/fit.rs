@@ -23,7 +23,9 @@ leave-one-subject-out errors, the published coefficients' fit on the same rows, 
 reports/ (per relation: data with refit curve, 95 % band and published curve; residuals vs \
 fitted; normal Q–Q; summary.md). Files are replaced atomically; a relation that fails to fit \
 leaves its existing fits/ files untouched and makes the command exit 1.\n\n\
-Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf.",
+Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf, kb-mu \
+(Ko & Badler 1993 eqs. 21–24: one observation per μ-function and row, α bounds enforced; r² is \
+pooled with each μ centred on its own mean; per-μ statistics are listed as derived).",
     after_help = "Examples:\n  gaitfit fit                                   # data/*.csv, all relations\n  \
 gaitfit fit --data my_trials.csv --relation run-sl-v\n  \
 gaitfit fit --robust --bootstrap 1000 --seed 7"
@@ -32,7 +34,7 @@ pub struct Args {
     /// Trials tables (CSV) to fit on, fitted together. Default: every data/*.csv.
     #[arg(long = "data", value_name = "FILE", num_args = 1..)]
     pub data: Vec<PathBuf>,
-    /// Relation id(s) to fit. Default: all (relations whose gait has no rows are skipped).
+    /// Relation id(s) to fit. Default: all (relations with no usable rows are skipped).
     #[arg(long = "relation", value_name = "ID", num_args = 1..)]
     pub relation: Vec<String>,
     /// Folder for the fit records (JSON and TOML per relation).

@@ -12,6 +12,7 @@
 //! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
 use thiserror::Error;
 
+pub mod constrained;
 pub mod nonlinear;
 pub mod ols;
 pub mod pipeline;

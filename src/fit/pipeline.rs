@@ -189,23 +189,35 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
                 }
                 None => 1.0,
             };
-            match rel.observe(&t.values(i)) {
-                Ok(o) => {
-                    let name = t.subject_name(i);
-                    let k = match subj_index.get(name) {
-                        Some(&k) => k,
-                        None => {
-                            let k = p.subjects.len();
-                            p.subjects.push(name.to_string());
-                            subj_index.insert(name.to_string(), k);
-                            k
-                        }
-                    };
-                    p.obs.push(o);
-                    p.subject.push(k);
-                    p.weights.push(w);
+            // A row gives one observation per output; it is rejected when none is usable.
+            let row = t.values(i);
+            let mut first_err = None;
+            let mut used = false;
+            for out in 0..rel.outputs() {
+                match rel.observe_output(&row, out) {
+                    Ok(o) => {
+                        let name = t.subject_name(i);
+                        let k = match subj_index.get(name) {
+                            Some(&k) => k,
+                            None => {
+                                let k = p.subjects.len();
+                                p.subjects.push(name.to_string());
+                                subj_index.insert(name.to_string(), k);
+                                k
+                            }
+                        };
+                        p.obs.push(o);
+                        p.subject.push(k);
+                        p.weights.push(w);
+                        used = true;
+                    }
+                    Err(r) => {
+                        first_err.get_or_insert(r);
+                    }
                 }
-                Err(r) => reject(r.to_string(), &file, i + 1, &mut p),
+            }
+            if let (false, Some(r)) = (used, first_err) {
+                reject(r.to_string(), &file, i + 1, &mut p);
             }
         }
     }
@@ -755,6 +767,17 @@ pub fn fit_relation(
             p = profile(rel, &lay, &p, &plan.search, &prep, None, None)?;
         }
     }
+    // Bounded parameters (Relation::bounds): argmin's bounded fit decides which sit on a bound.
+    let mut bound_flag: Vec<Option<String>> = vec![None; specs.len()];
+    let (hits, bound_note) =
+        super::constrained::active_bounds(rel, &prep, &free, &p, opts.weights.is_some())?;
+    notes.extend(bound_note);
+    for b in hits {
+        free[b.index] = false;
+        p[b.index] = b.value;
+        held_reason[b.index] = Some(b.describe(specs[b.index].name));
+        bound_flag[b.index] = Some("bound active".into());
+    }
     lay = Layout::new(rel, free.clone(), n_subj);
     let nc = lay.ncols();
     let n_bp = free
@@ -837,6 +860,7 @@ pub fn fit_relation(
             }
         }
     }
+    notes.extend(super::constrained::violations(rel, &values, &free));
     // Fitted values and residuals in the response's terms.
     let fitted: Vec<f64> = (0..n).map(|i| offsets[i] + lf.fitted[i]).collect();
     let obs_y: Vec<f64> = prep.obs.iter().map(|o| o.y).collect();
@@ -878,7 +902,7 @@ pub fn fit_relation(
                 let v = out[j];
                 (v, Some(se), [opt(v - tq * se), opt(v + tq * se)])
             } else {
-                (published[i], None, [None, None])
+                (p[i], None, [None, None])
             }
         } else if free[i] {
             let (lo, hi) = profile_interval(rel, &lay, &p, i, &plan.search, &prep, df, tq)?;
@@ -912,7 +936,7 @@ pub fn fit_relation(
             } else {
                 held_reason[i].clone()
             },
-            flag: None,
+            flag: bound_flag[i].clone(),
         });
     }
     let n_lin = rel.n_linear();
@@ -1023,6 +1047,20 @@ pub fn fit_relation(
         r2_uncentred(&obs_y, pub_rss, wopt)
     };
     let pub_rmse = (pub_res.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
+    // Several outputs per row (kb-mu): r² centred within each output, per-output statistics.
+    let multi = super::constrained::output_stats(
+        rel,
+        &prep,
+        &residuals,
+        lf.leverage.as_slice(),
+        &pub_res,
+        weighted,
+        df,
+    );
+    let (r2, r2_def, adj_r2, pub_r2) = match &multi {
+        Some(m) => (m.r2, m.definition.clone(), m.adj_r2, m.published_r2),
+        None => (r2, r2_def, adj_r2, pub_r2),
+    };
 
     // Robust refit.
     let robust = if opts.robust {
@@ -1151,6 +1189,7 @@ pub fn fit_relation(
             unit: unit.to_string(),
             value: v,
         })
+        .chain(multi.into_iter().flat_map(|m| m.derived))
         .collect();
     let (path, sha256) = if prep.files.len() == 1 {
         (prep.files[0].path.clone(), prep.files[0].sha256.clone())
@@ -1343,8 +1382,9 @@ pub struct FitRun {
     pub skipped: Vec<(String, String)>,
 }
 
-/// Fits each relation on the tables. A relation whose gait has no rows is *skipped* when
-/// `skip_missing_gait` (the default run over all relations), otherwise it fails.
+/// Fits each relation on the tables. A relation whose gait has no rows, or none that it can
+/// use, is *skipped* when `skip_missing_gait` (the default run over all relations), otherwise
+/// it fails.
 pub fn fit_all(
     relations: &[Box<dyn Relation>],
     tables: &[TrialsTable],
@@ -1367,6 +1407,10 @@ pub fn fit_all(
         }
         match fit_relation(rel.as_ref(), tables, opts) {
             Ok(o) => run.outcomes.push(o),
+            // Rows of the gait but none usable (e.g. no μ columns for kb-mu): nothing to fit.
+            Err(e @ FitError::TooFew { have: 0, .. }) if skip_missing_gait => run
+                .skipped
+                .push((rel.id().to_string(), format!("no usable rows: {e}"))),
             Err(e) => run.failures.push((rel.id().to_string(), e.to_string())),
         }
     }

@@ -1,5 +1,5 @@
 //! `kb-mu`: the μ-functions of Ko & Badler (1993), appendix A, eqs. 21–24, fitted to measured
-//! per-step angles.
+//! per-step angles by the generic pipeline (`gaitfit fit --relation kb-mu`).
 //!
 //! ```text
 //! μ₁ = −α₁ (x − sl*) + μ₁*   knee flexion at heel strike          knee_angle_hs
@@ -10,26 +10,51 @@
 //! ```
 //!
 //! Units: angles rad, lengths m, α rad/m. Bounds (appendix A): α₁ ∈ [0, 0.3], α₂…α₄ > 0
-//! (enforced as ≥ 0); μ* free. sl* is the bundled prototype's step length (Winter's), held: with
-//! a free intercept μᵢ* it is not identifiable. ll(S*) is Winter's leg length *as the trials
-//! tables measure leg length* (the `bmclab_WinterTableA1` row), so that x compares like with like;
-//! without that row, the prototype's model leg length.
+//! (enforced as ≥ 0 by argmin in the pipeline, which reports an active bound). sl* and ll(S*)
+//! are held: with a free intercept μᵢ* the pair (sl*, μᵢ*) is not identifiable.
 //!
-//! One trials row (one step) gives up to four observations, one per μ; the fit is argmin's
-//! bounded trust region ([`crate::fit::nonlinear::nls`]) on all of them at once, and a
-//! coefficient that ends on its bound is reported (its standard error is then undefined).
+//! **Several outputs.** One trials row (one step) gives up to four observations, one per μ
+//! ([`Relation::outputs`]): the observation's inputs are `x` and the μ index `i` (0…3). The
+//! model is linear in α and μ* (a separate line per μ), so the generic linear machinery applies;
+//! r² is pooled with each μ centred on its own mean, and per-μ n, r², rmse and leave-one-out
+//! rmse are reported as derived quantities (see `fit::constrained`).
+//!
+//! **"Published" values.** The paper gives no α (only α₁'s range); the published α are 0 — the
+//! similarity assumption alone (angles independent of step length), so each t-test asks whether
+//! the data show a slope. μ₁*…μ₄* and sl* are the bundled prototype's (`data/prototype_winter.json`,
+//! Winter's walk), the values the generator uses. The events layer measures the knee and meta
+//! angles with other zero references than the prototype builder (see
+//! `generator::generalize::prototype`), so the fitted μ₁*, μ₄* differ from the prototype's by
+//! that offset as much as by subject; the slopes α do not depend on it.
+//!
+//! ll(S*) is Winter's leg length *as the trials tables measure leg length* (the
+//! `bmclab_WinterTableA1` row of `data/walk_bmclab.csv`, [`WINTER_TABLE_LEG_LENGTH`]), so that x
+//! compares like with like.
+//!
 //! Sign conventions are those of the events layer (`events::phases::mu_inputs`): knee flexion
 //! positive, foot angle at heel strike toes-up positive, at toe off heel-up positive, meta angle
 //! metatarsal heads above the toe tip positive — the generator's conventions
-//! ([`crate::generator::generalize::mu`]). The events layer measures the meta angle from the
-//! mid-stance toe line and the generator's prototype from the toe line at meta off (see
-//! `generator::generalize::prototype`), so the fitted μ₄* and the prototype's differ by that
-//! offset; the slope α₄ does not depend on it.
-use crate::fit::nonlinear::{nls, Model, NlsOptions, Rows};
-use crate::fit::FitError;
-use crate::ingest::trials::TrialsTable;
+//! ([`crate::generator::generalize::mu`]).
+//!
+//! ```
+//! use gaitfit::relations::{kb_mu::KbMu, Relation};
+//! let r = KbMu::published();
+//! // At the prototype's own step length and leg length every μ is the prototype's μ*.
+//! let x = r.argument(r.sl_star(), r.ll_star());
+//! assert!((r.mu(2, x) - r.mu_star()[2]).abs() < 1e-15);
+//! assert_eq!(r.outputs(), 4);
+//! ```
+use super::{
+    expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
+    ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
+};
+use crate::events::Gait;
+use crate::fit::nonlinear::Model;
+use crate::ingest::trials::FieldValues;
 use crate::units::Quantity;
-use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::OnceLock;
 
 /// Relation id.
 pub const ID: &str = "kb-mu";
@@ -37,6 +62,9 @@ pub const ID: &str = "kb-mu";
 pub const ALPHA1_MAX: f64 = 0.3;
 /// Subject name of Winter's row in the bundled tables (its leg length defines ll(S*)).
 pub const WINTER_SUBJECT: &str = "bmclab_WinterTableA1";
+/// Winter's leg length as the trials tables measure it (`leg_length_m` of the
+/// `bmclab_WinterTableA1` row of `data/walk_bmclab.csv`; checked by `tests/kb_mu_fit.rs`), m.
+pub const WINTER_TABLE_LEG_LENGTH: f64 = 0.81;
 /// The μ columns, in μ₁…μ₄ order.
 pub const MU_QUANTITIES: [Quantity; 4] = [
     Quantity::KneeAngleHs,
@@ -44,39 +72,314 @@ pub const MU_QUANTITIES: [Quantity; 4] = [
     Quantity::FootAngleTo,
     Quantity::MetaAngleTo,
 ];
-/// Coefficient names, in θ order.
-pub const NAMES: [&str; 8] = [
+/// Coefficient names, in [`Relation::parameters`] order.
+pub const NAMES: [&str; 10] = [
     "alpha1", "alpha2", "alpha3", "alpha4", "mu1_star", "mu2_star", "mu3_star", "mu4_star",
+    "sl_star", "ll_star",
+];
+/// Index of sl* among the parameters.
+const SL_STAR: usize = 8;
+/// Index of ll(S*) among the parameters.
+const LL_STAR: usize = 9;
+/// Names of the four outputs.
+const OUTPUT_NAMES: [&str; 4] = ["mu1", "mu2", "mu3", "mu4"];
+
+const INPUTS: &[Variable] = &[
+    Variable {
+        symbol: "x",
+        unit: "m",
+        name: "leg-length-normalized step length sl·ll(S*)/ll(S)",
+    },
+    Variable {
+        symbol: "i",
+        unit: "-",
+        name: "μ-function index (0…3 for μ1…μ4)",
+    },
 ];
 
-/// One observation: which μ (0…3), the argument x (m) and the measured angle (rad).
-#[derive(Debug, Clone, PartialEq)]
-pub struct MuObservation {
-    /// Subject.
-    pub subject: String,
-    /// 0…3 for μ₁…μ₄.
-    pub index: usize,
-    /// x = sl·ll(S*)/ll(S), m.
-    pub x: f64,
-    /// Measured μ, rad.
-    pub y: f64,
+fn sign(i: usize) -> f64 {
+    if i == 0 {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
-/// The μ-function model for [`nls`]: row = (x, index), θ = (α₁…α₄, μ₁*…μ₄*).
+/// The parameter table: α published as 0 (the paper gives none), μ* and sl* the bundled
+/// prototype's. Built once (it reads the bundled prototype).
+fn params() -> &'static [ParameterSpec] {
+    static P: OnceLock<Vec<ParameterSpec>> = OnceLock::new();
+    P.get_or_init(|| {
+        let proto = crate::generator::generalize::prototype::Prototype::bundled();
+        let alpha = |name: &'static str, description: &'static str| ParameterSpec {
+            name,
+            unit: "rad/m",
+            published: 0.0,
+            kind: ParamKind::Linear,
+            description,
+        };
+        let star = |k: usize, description: &'static str| ParameterSpec {
+            name: NAMES[4 + k],
+            unit: "rad",
+            published: proto.mu_star[k],
+            kind: ParamKind::Linear,
+            description,
+        };
+        vec![
+            alpha(
+                "alpha1",
+                "slope of μ1 (knee flexion at heel strike, decreasing) with x; the paper gives \
+                 only [0, 0.3]; published 0 = the similarity assumption alone",
+            ),
+            alpha(
+                "alpha2",
+                "slope of μ2 (foot angle at heel strike) with x; published 0 = none",
+            ),
+            alpha(
+                "alpha3",
+                "slope of μ3 (foot angle at toe off) with x; published 0 = none",
+            ),
+            alpha(
+                "alpha4",
+                "slope of μ4 (meta angle at toe off) with x; published 0 = none",
+            ),
+            star(
+                0,
+                "μ1 at sl* (published: the bundled prototype's knee angle at heel strike)",
+            ),
+            star(
+                1,
+                "μ2 at sl* (published: the bundled prototype's foot angle at heel strike)",
+            ),
+            star(
+                2,
+                "μ3 at sl* (published: the bundled prototype's foot angle at toe off)",
+            ),
+            star(
+                3,
+                "μ4 at sl* (published: the bundled prototype's meta angle at toe off)",
+            ),
+            ParameterSpec {
+                name: "sl_star",
+                unit: "m",
+                published: proto.walk.step_length(),
+                kind: ParamKind::Breakpoint,
+                description: "the bundled prototype's step length",
+            },
+            ParameterSpec {
+                name: "ll_star",
+                unit: "m",
+                published: WINTER_TABLE_LEG_LENGTH,
+                kind: ParamKind::Breakpoint,
+                description: "Winter's leg length as the trials tables measure it",
+            },
+        ]
+    })
+}
+
+/// The μ-functions (eqs. 21–24) as a fittable relation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KbMu {
+    values: Vec<f64>,
+    levels: BTreeMap<String, f64>,
+}
+
+impl KbMu {
+    /// The id.
+    pub const ID: &'static str = ID;
+
+    /// α = 0 and the bundled prototype's μ*, sl*; ll(S*) = [`WINTER_TABLE_LEG_LENGTH`].
+    pub fn published() -> Self {
+        KbMu {
+            values: params().iter().map(|s| s.published).collect(),
+            levels: BTreeMap::new(),
+        }
+    }
+    /// From a coefficient set.
+    pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
+        let (values, levels) = set.split(params(), None)?;
+        Ok(KbMu { values, levels })
+    }
+    /// From `fits/kb-mu.json`.
+    pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
+        let set = CoefficientSet::from_fit_file(path)?;
+        expect_id(&set, ID, path)?;
+        Self::from_coefficients(&set)
+    }
+    /// α₁…α₄ (rad/m).
+    pub fn alpha(&self) -> [f64; 4] {
+        [
+            self.values[0],
+            self.values[1],
+            self.values[2],
+            self.values[3],
+        ]
+    }
+    /// μ₁*…μ₄* (rad).
+    pub fn mu_star(&self) -> [f64; 4] {
+        [
+            self.values[4],
+            self.values[5],
+            self.values[6],
+            self.values[7],
+        ]
+    }
+    /// sl* (m).
+    pub fn sl_star(&self) -> f64 {
+        self.values[SL_STAR]
+    }
+    /// ll(S*) in the tables' definition of leg length (m).
+    pub fn ll_star(&self) -> f64 {
+        self.values[LL_STAR]
+    }
+    /// The μ argument x = sl·ll(S*)/ll(S) (m).
+    pub fn argument(&self, step_length: f64, leg_length: f64) -> f64 {
+        step_length * self.ll_star() / leg_length
+    }
+    /// μᵢ (rad, i = 0…3 for μ₁…μ₄) at argument `x` (m).
+    pub fn mu(&self, i: usize, x: f64) -> f64 {
+        sign(i) * self.values[i] * (x - self.sl_star()) + self.values[4 + i]
+    }
+}
+
+impl Relation for KbMu {
+    fn id(&self) -> &'static str {
+        ID
+    }
+    fn title(&self) -> &'static str {
+        "Ko–Badler μ-functions: joint angles at heel strike and toe off vs step length"
+    }
+    fn citation(&self) -> Citation {
+        Citation {
+            paper: "Ko & Badler (1993), Straight line walking animation based on kinematic \
+                    generalization that preserves the original characteristics",
+            equation: "appendix A, eqs. 21–24 (argument corrected to sl·ll(S*)/ll(S))",
+        }
+    }
+    fn equation(&self) -> &'static str {
+        "mu1 = -alpha1 (x - sl*) + mu1*; mu_i = alpha_i (x - sl*) + mu_i* (i = 2..4); \
+         x = sl ll(S*)/ll(S)"
+    }
+    fn response(&self) -> Variable {
+        Variable {
+            symbol: "mu",
+            unit: "rad",
+            name: "μ angle (knee at heel strike, foot at heel strike, foot at toe off, meta at toe off)",
+        }
+    }
+    fn inputs(&self) -> &'static [Variable] {
+        INPUTS
+    }
+    fn gait(&self) -> Gait {
+        Gait::Walk
+    }
+    fn needs(&self) -> &'static [Quantity] {
+        &[
+            Quantity::StepLength,
+            Quantity::LegLength,
+            Quantity::KneeAngleHs,
+            Quantity::FootAngleHs,
+            Quantity::FootAngleTo,
+            Quantity::MetaAngleTo,
+        ]
+    }
+    /// The first μ of the row ([`Relation::observe_output`] gives the others).
+    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
+        self.observe_output(row, 0)
+    }
+    fn outputs(&self) -> usize {
+        4
+    }
+    fn observe_output(&self, row: &FieldValues, k: usize) -> Result<Observation, Rejection> {
+        let q = MU_QUANTITIES[k.min(3)];
+        let y = row.get(q).ok_or(Rejection::Missing(q))?;
+        let sl = row
+            .get(Quantity::StepLength)
+            .ok_or(Rejection::Missing(Quantity::StepLength))?;
+        let ll = row
+            .get(Quantity::LegLength)
+            .ok_or(Rejection::Missing(Quantity::LegLength))?;
+        if !(ll > 0.0 && sl > 0.0) {
+            return Err(Rejection::Invalid(format!(
+                "step length {sl} m and leg length {ll} m must be positive"
+            )));
+        }
+        Ok(Observation {
+            x: [self.argument(sl, ll), k as f64, 0.0, 0.0],
+            y,
+        })
+    }
+    fn output_of(&self, x: &[f64]) -> usize {
+        (x[1].max(0.0) as usize).min(3)
+    }
+    fn output_name(&self, k: usize) -> String {
+        OUTPUT_NAMES[k.min(3)].to_string()
+    }
+    fn select_output(&self, x: &mut [f64], k: usize) {
+        x[1] = k as f64;
+    }
+    fn parameters(&self) -> &'static [ParameterSpec] {
+        params()
+    }
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        match i {
+            0 => (0.0, ALPHA1_MAX),
+            1..=3 => (0.0, f64::INFINITY),
+            _ => (f64::NEG_INFINITY, f64::INFINITY),
+        }
+    }
+    fn has_intercept(&self) -> bool {
+        true
+    }
+    fn domain(&self) -> Domain {
+        Domain {
+            input: "x",
+            lo: 0.0,
+            hi: f64::INFINITY,
+            note: "the paper states no range; μ₂…μ₄ must stay positive (they scale F₁, F₂, M)",
+        }
+    }
+    fn values(&self) -> &[f64] {
+        &self.values
+    }
+    fn subject_levels(&self) -> &BTreeMap<String, f64> {
+        &self.levels
+    }
+    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]) {
+        g.iter_mut().for_each(|v| *v = 0.0);
+        let i = self.output_of(x);
+        g[i] = sign(i) * (x[0] - p[SL_STAR]);
+        g[4 + i] = 1.0;
+    }
+    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+        Some(linear_gradient(self, p, x))
+    }
+    fn plan(&self, _obs: &[Observation]) -> Plan {
+        let mut held = vec![None; NAMES.len()];
+        held[SL_STAR] = Some(
+            "held at the bundled prototype's step length: not identifiable beside free μ*".into(),
+        );
+        held[LL_STAR] =
+            Some("held at Winter's leg length as the trials tables measure it (defines x)".into());
+        Plan {
+            held,
+            search: vec![None; NAMES.len()],
+        }
+    }
+    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
+        Box::new(KbMu {
+            values: values.to_vec(),
+            levels,
+        })
+    }
+}
+
+/// The μ-function model for [`crate::fit::nonlinear::nls`]: row = (x, index), θ = (α₁…α₄,
+/// μ₁*…μ₄*); an independent formulation used by the tests.
 #[derive(Debug, Clone, Copy)]
 pub struct MuModel {
     /// sl*, m.
     pub sl_star: f64,
-}
-
-impl MuModel {
-    fn sign(i: usize) -> f64 {
-        if i == 0 {
-            -1.0
-        } else {
-            1.0
-        }
-    }
 }
 
 impl Model for MuModel {
@@ -85,320 +388,28 @@ impl Model for MuModel {
     }
     fn value(&self, x: &[f64], t: &[f64]) -> f64 {
         let i = x[1] as usize;
-        Self::sign(i) * t[i] * (x[0] - self.sl_star) + t[4 + i]
+        sign(i) * t[i] * (x[0] - self.sl_star) + t[4 + i]
     }
     fn gradient(&self, x: &[f64], _t: &[f64], out: &mut [f64]) {
         out.iter_mut().for_each(|g| *g = 0.0);
         let i = x[1] as usize;
-        out[i] = Self::sign(i) * (x[0] - self.sl_star);
+        out[i] = sign(i) * (x[0] - self.sl_star);
         out[4 + i] = 1.0;
     }
 }
 
-fn col(t: &TrialsTable, q: Quantity) -> Option<&Vec<f64>> {
-    t.columns[q as usize].as_ref()
-}
-
-/// The observations of the trials tables: every row with a step length, a leg length and any
-/// of the four μ columns. Returns the observations, the ll(S*) used and the rows skipped (with
-/// why).
-pub fn observations(
-    tables: &[TrialsTable],
-    prototype_leg_length: f64,
-) -> (Vec<MuObservation>, f64, Vec<String>) {
-    // ll(S*) in the tables' own definition of leg length, from Winter's row.
-    let mut ll_star = prototype_leg_length;
-    for t in tables {
-        if let Some(ll) = col(t, Quantity::LegLength) {
-            for (i, &v) in ll.iter().enumerate() {
-                if t.subject_name(i) == WINTER_SUBJECT && v.is_finite() {
-                    ll_star = v;
-                }
-            }
-        }
-    }
-    let mut out = Vec::new();
-    let mut skipped = Vec::new();
-    for t in tables {
-        let (Some(sl), Some(ll)) = (col(t, Quantity::StepLength), col(t, Quantity::LegLength))
-        else {
-            continue;
-        };
-        for i in 0..t.len() {
-            let mus: Vec<(usize, f64)> = MU_QUANTITIES
-                .iter()
-                .enumerate()
-                .filter_map(|(k, q)| col(t, *q).map(|c| (k, c[i])))
-                .filter(|(_, v)| v.is_finite())
-                .collect();
-            if mus.is_empty() {
-                continue;
-            }
-            if t.is_flagged[i] {
-                skipped.push(format!("{}: row {}: flagged", t.path.display(), i + 1));
-                continue;
-            }
-            if !(sl[i].is_finite() && ll[i].is_finite() && ll[i] > 0.0) {
-                skipped.push(format!(
-                    "{}: row {}: step length or leg length missing",
-                    t.path.display(),
-                    i + 1
-                ));
-                continue;
-            }
-            let x = sl[i] * ll_star / ll[i];
-            for (k, y) in mus {
-                out.push(MuObservation {
-                    subject: t.subject_name(i).to_string(),
-                    index: k,
-                    x,
-                    y,
-                });
-            }
-        }
-    }
-    (out, ll_star, skipped)
-}
-
-/// One fitted coefficient.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Coefficient {
-    /// Name (`alpha1`, …, `mu4_star`, `sl_star`).
-    pub name: String,
-    /// Unit.
-    pub unit: String,
-    /// Value.
-    pub value: f64,
-    /// Standard error (`None` when held or on a bound).
-    pub std_error: Option<f64>,
-    /// Why it is held, if it is.
-    pub held: Option<String>,
-    /// Active bound or other remark.
-    pub flag: Option<String>,
-}
-
-/// Per-μ statistics.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PerMu {
-    /// `mu1` … `mu4`.
-    pub mu: String,
-    /// Observations.
-    pub n: usize,
-    /// RMS residual, rad.
-    pub rmse_rad: f64,
-    /// RMS residual, degrees.
-    pub rmse_deg: f64,
-    /// Centred r² of this μ's line.
-    pub r_squared: f64,
-    /// Range of x, m.
-    pub x_range_m: [f64; 2],
-}
-
-/// The fitted μ-functions with their statistics (written as `fits/ko-badler/kb-mu.json`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct KbMuFit {
-    /// `kb-mu`.
-    pub relation: String,
-    /// Title.
-    pub title: String,
-    /// Paper and equations.
-    pub citation: String,
-    /// The formula.
-    pub equation: String,
-    /// Observations (μ values).
-    pub n: usize,
-    /// Distinct subjects.
-    pub n_subjects: usize,
-    /// Coefficients: α₁…α₄, μ₁*…μ₄*, sl* (held) and ll(S*) (held).
-    pub coefficients: Vec<Coefficient>,
-    /// Overall RMS residual, rad.
-    pub rmse: f64,
-    /// Leave-one-out RMS residual (linearized), rad.
-    pub loo_rmse: f64,
-    /// Residual mean square RSS/(n − p), rad².
-    pub residual_mean_square: f64,
-    /// Per-μ statistics.
-    pub per_mu: Vec<PerMu>,
-    /// Whether the optimizer converged, and how it stopped.
-    pub termination: String,
-    /// Notes (active bounds, skipped rows, sources).
-    pub notes: Vec<String>,
-    /// gaitfit version.
-    pub gaitfit_version: String,
-}
-
-impl KbMuFit {
-    /// The value of coefficient `name`.
-    pub fn get(&self, name: &str) -> Option<f64> {
-        self.coefficients
-            .iter()
-            .find(|c| c.name == name)
-            .map(|c| c.value)
-    }
-    /// α₁…α₄.
-    pub fn alpha(&self) -> [f64; 4] {
-        let g = |n: &str| self.get(n).unwrap_or(f64::NAN);
-        [g("alpha1"), g("alpha2"), g("alpha3"), g("alpha4")]
-    }
-}
-
-/// Fits α₁…α₄ and μ₁*…μ₄* to `obs` with sl* = `sl_star`, bounds α₁ ∈ [0, 0.3], α₂…α₄ ≥ 0.
-pub fn fit(
-    obs: &[MuObservation],
-    sl_star: f64,
-    ll_star: f64,
-    notes: Vec<String>,
-) -> Result<KbMuFit, FitError> {
-    let mut counts = [0usize; 4];
-    for o in obs {
-        counts[o.index] += 1;
-    }
-    if let Some(i) = counts.iter().position(|&c| c < 2) {
-        return Err(FitError::TooFew {
-            relation: ID.into(),
-            what: format!("observations of mu{}", i + 1),
-            have: counts[i],
-            need: 2,
-        });
-    }
-    let rows: Vec<f64> = obs.iter().flat_map(|o| [o.x, o.index as f64]).collect();
-    let y: Vec<f64> = obs.iter().map(|o| o.y).collect();
-    // Start: each μ's own least-squares line, slope clamped into its bounds.
-    let bounds = bounds();
-    let mut start = [0.0; 8];
-    for i in 0..4 {
-        let (s, b) = separable_line(obs, i, sl_star, (f64::NEG_INFINITY, f64::INFINITY));
-        start[i] = s.clamp(bounds[i].0, bounds[i].1.min(1e3));
-        start[4 + i] = b;
-    }
-    let model = MuModel { sl_star };
-    let opts = NlsOptions {
-        name: ID.into(),
-        bounds: Some(bounds.to_vec()),
-        ..NlsOptions::default()
-    };
-    let r = nls(&model, Rows::new(&rows, 2)?, &y, &start, &opts)?;
-    let mut notes = notes;
-    let mut coefficients = Vec::new();
-    for (k, name) in NAMES.iter().enumerate() {
-        let flag = r.active_bounds[k].then(|| {
-            let (lo, hi) = bounds[k];
-            let which = if (r.theta[k] - lo).abs() <= (r.theta[k] - hi).abs() {
-                lo
-            } else {
-                hi
-            };
-            let msg = format!(
-                "bound active: {name} = {which} (allowed [{lo}, {hi}]; the data alone want it \
-                 beyond)"
-            );
-            notes.push(msg.clone());
-            msg
-        });
-        coefficients.push(Coefficient {
-            name: name.to_string(),
-            unit: if k < 4 { "rad/m" } else { "rad" }.into(),
-            value: r.theta[k],
-            std_error: r.std_error[k].is_finite().then_some(r.std_error[k]),
-            held: None,
-            flag,
-        });
-    }
-    coefficients.push(Coefficient {
-        name: "sl_star".into(),
-        unit: "m".into(),
-        value: sl_star,
-        std_error: None,
-        held: Some(
-            "the bundled prototype's step length (Winter); not identifiable beside a free μ*"
-                .into(),
-        ),
-        flag: None,
-    });
-    coefficients.push(Coefficient {
-        name: "ll_star".into(),
-        unit: "m".into(),
-        value: ll_star,
-        std_error: None,
-        held: Some("Winter's leg length as the trials tables measure it".into()),
-        flag: None,
-    });
-    let per_mu = (0..4)
-        .map(|i| {
-            let idx: Vec<usize> = (0..obs.len()).filter(|&j| obs[j].index == i).collect();
-            let n = idx.len();
-            let rss: f64 = idx.iter().map(|&j| r.residuals[j].powi(2)).sum();
-            let mean = idx.iter().map(|&j| y[j]).sum::<f64>() / n as f64;
-            let tss: f64 = idx.iter().map(|&j| (y[j] - mean).powi(2)).sum();
-            let xs = idx.iter().map(|&j| obs[j].x);
-            let lo = xs.clone().fold(f64::INFINITY, f64::min);
-            let hi = xs.fold(f64::NEG_INFINITY, f64::max);
-            let rmse = (rss / n as f64).sqrt();
-            PerMu {
-                mu: format!("mu{}", i + 1),
-                n,
-                rmse_rad: rmse,
-                rmse_deg: rmse.to_degrees(),
-                r_squared: if tss > 0.0 { 1.0 - rss / tss } else { f64::NAN },
-                x_range_m: [lo, hi],
-            }
-        })
-        .collect();
-    let mut subjects: Vec<&str> = obs.iter().map(|o| o.subject.as_str()).collect();
-    subjects.sort();
-    subjects.dedup();
-    Ok(KbMuFit {
-        relation: ID.into(),
-        title: "Ko–Badler μ-functions: joint angles at heel strike and toe off vs step length"
-            .into(),
-        citation: "Ko & Badler (1993), Straight line walking animation based on kinematic \
-                   generalization that preserves the original characteristics, appendix A, \
-                   eqs. 21–24 (argument corrected to sl·ll(S*)/ll(S))"
-            .into(),
-        equation: "mu1 = -alpha1 (x - sl*) + mu1*; mu_i = alpha_i (x - sl*) + mu_i* (i = 2..4); \
-                   x = sl ll(S*)/ll(S)"
-            .into(),
-        n: obs.len(),
-        n_subjects: subjects.len(),
-        coefficients,
-        rmse: (r.rss / obs.len() as f64).sqrt(),
-        loo_rmse: r.press_rmse(),
-        residual_mean_square: r.rss / r.df_resid.max(1) as f64,
-        per_mu,
-        termination: format!("converged: {}; {}", r.converged, r.termination),
-        notes,
-        gaitfit_version: crate::GAITFIT_VERSION.into(),
-    })
-}
-
-/// The paper's bounds in θ order: α₁ ∈ [0, 0.3], α₂…α₄ ≥ 0, μ* free.
-pub fn bounds() -> [(f64, f64); 8] {
-    let free = (f64::NEG_INFINITY, f64::INFINITY);
-    [
-        (0.0, ALPHA1_MAX),
-        (0.0, f64::INFINITY),
-        (0.0, f64::INFINITY),
-        (0.0, f64::INFINITY),
-        free,
-        free,
-        free,
-        free,
-    ]
-}
-
-/// The least-squares line of μᵢ on x with its slope (in the μ's own sign convention) restricted
-/// to `slope_bounds`: the closed form a bounded fit of this separable model must reproduce
-/// (an independent check of [`fit`]). Returns (αᵢ, μᵢ*).
+/// The least-squares line of μᵢ on x (points `(x, μ)`) with its slope (in the μ's own sign
+/// convention) restricted to `slope_bounds`: the closed form a bounded fit of this separable
+/// model must reproduce (an independent check of the pipeline). Returns (αᵢ, μᵢ*).
 pub fn separable_line(
-    obs: &[MuObservation],
+    points: &[(f64, f64)],
     i: usize,
     sl_star: f64,
     slope_bounds: (f64, f64),
 ) -> (f64, f64) {
-    let pts: Vec<(f64, f64)> = obs
+    let pts: Vec<(f64, f64)> = points
         .iter()
-        .filter(|o| o.index == i)
-        .map(|o| (MuModel::sign(i) * (o.x - sl_star), o.y))
+        .map(|&(x, y)| (sign(i) * (x - sl_star), y))
         .collect();
     let n = pts.len() as f64;
     let mx = pts.iter().map(|p| p.0).sum::<f64>() / n;
@@ -409,26 +420,28 @@ pub fn separable_line(
     (slope, my - slope * mx)
 }
 
-/// Reads the trials tables, fits and writes `out` (JSON, via `fsio::write_atomic_bytes`).
-pub fn fit_tables(
-    paths: &[std::path::PathBuf],
-    prototype: &crate::generator::generalize::prototype::Prototype,
-    out: Option<&std::path::Path>,
-) -> crate::Result<KbMuFit> {
-    let mut tables = Vec::new();
-    for p in paths {
-        tables.push(crate::ingest::trials::read_trials(p)?);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn basis_reproduces_the_mu_functions() {
+        let mut r = KbMu::published();
+        r.values[..8].copy_from_slice(&[0.1, 0.5, 0.9, 1.3, 0.05, 0.4, 1.2, 0.9]);
+        for i in 0..4 {
+            let x = [0.63, i as f64, 0.0, 0.0];
+            let want = sign(i) * r.values[i] * (0.63 - r.sl_star()) + r.values[4 + i];
+            assert!((r.predict(&x) - want).abs() < 1e-15);
+            assert!((r.mu(i, 0.63) - want).abs() < 1e-15);
+        }
     }
-    let (obs, ll_star, skipped) = observations(&tables, prototype.walk.body().leg_length());
-    let mut notes: Vec<String> = paths
-        .iter()
-        .map(|p| format!("data: {}", p.display()))
-        .collect();
-    notes.extend(skipped.into_iter().map(|s| format!("skipped: {s}")));
-    let f = fit(&obs, prototype.walk.step_length(), ll_star, notes)?;
-    if let Some(out) = out {
-        let text = serde_json::to_string_pretty(&f).unwrap_or_default() + "\n";
-        crate::fsio::write_atomic_bytes(out, text.as_bytes())?;
+
+    #[test]
+    fn published_values_are_the_prototypes() {
+        let p = crate::generator::generalize::prototype::Prototype::bundled();
+        let r = KbMu::published();
+        assert_eq!(r.mu_star(), p.mu_star);
+        assert_eq!(r.sl_star(), p.walk.step_length());
+        assert_eq!(r.alpha(), [0.0; 4]);
     }
-    Ok(f)
 }

@@ -7,6 +7,7 @@
 //! | `run-tflight-sf-continuous` | [`RunTflightSf`] (continuous at `k1`) | running 1996, eqs. 4–5 |
 //! | `walk-sl-sf` | [`WalkSlSf`] | walking 1989, eq. 1 |
 //! | `walk-tds-sf` | [`WalkTdsSf`] | walking 1989, §3 (t_ds formula) |
+//! | `kb-mu` | [`KbMu`] (four outputs, bounded) | Ko & Badler 1993, appendix A, eqs. 21–24 |
 //!
 //! # Using a relation (generators)
 //! Every type has `published()` (the papers' coefficients), typed evaluation methods in the
@@ -40,6 +41,7 @@ pub mod run_tflight_sf;
 pub mod walk_sl_sf;
 pub mod walk_tds_sf;
 
+pub use kb_mu::KbMu;
 pub use run_sl_v::RunSlV;
 pub use run_tflight_sf::{Continuity, RunTflightSf};
 pub use walk_sl_sf::WalkSlSf;
@@ -415,6 +417,44 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
     fn index_of(&self, name: &str) -> Option<usize> {
         self.parameters().iter().position(|s| s.name == name)
     }
+
+    /// Number of observations one row can give (1; `kb-mu` gives one per μ-function). The
+    /// pipeline then pools them, centres r² within each output and reports per-output
+    /// statistics.
+    fn outputs(&self) -> usize {
+        1
+    }
+
+    /// Reduces a row to its `k`-th observation (`k <` [`Relation::outputs`]); by default
+    /// [`Relation::observe`]. A row is rejected only when none of its outputs is usable.
+    fn observe_output(&self, row: &FieldValues, k: usize) -> Result<Observation, Rejection> {
+        let _ = k;
+        self.observe(row)
+    }
+
+    /// Which output an observation's inputs belong to (0 for single-output relations).
+    fn output_of(&self, x: &[f64]) -> usize {
+        let _ = x;
+        0
+    }
+
+    /// Name of output `k` (for reports).
+    fn output_name(&self, k: usize) -> String {
+        let _ = k;
+        self.response().symbol.to_string()
+    }
+
+    /// Sets the inputs that select output `k` (for plotting one curve per output).
+    fn select_output(&self, x: &mut [f64], k: usize) {
+        let _ = (x, k);
+    }
+
+    /// The allowed range of parameter `i` (unbounded by default). Where a bound is finite the
+    /// pipeline enforces it with argmin's bounded least squares and reports an active bound.
+    fn bounds(&self, i: usize) -> (f64, f64) {
+        let _ = i;
+        (f64::NEG_INFINITY, f64::INFINITY)
+    }
 }
 
 /// A named set of coefficient values for one relation (what a fits file carries).
@@ -512,6 +552,7 @@ pub fn registry() -> Vec<Box<dyn Relation>> {
         Box::new(RunTflightSf::published_continuous()),
         Box::new(WalkSlSf::published()),
         Box::new(WalkTdsSf::published()),
+        Box::new(KbMu::published()),
     ]
 }
 

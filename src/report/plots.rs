@@ -63,13 +63,22 @@ fn main_plot<DB: DrawingBackend>(
         });
     let (xlo, xhi) = pad(xlo, xhi);
     const K: usize = 200;
-    let curve: Vec<(f64, f64, f64, f64, f64)> = (0..=K)
-        .map(|k| {
-            let x0 = xlo + (xhi - xlo) * k as f64 / K as f64;
-            let mut x = mean_x;
-            x[0] = x0;
-            let (m, lo, hi) = o.band(&x);
-            (x0, m, lo, hi, o.published.predict(&x))
+    // One curve per output (kb-mu's four μ-functions), else one at the other inputs' means.
+    let n_out = rel.outputs();
+    let curves: Vec<Vec<(f64, f64, f64, f64, f64)>> = (0..n_out)
+        .map(|out| {
+            (0..=K)
+                .map(|k| {
+                    let x0 = xlo + (xhi - xlo) * k as f64 / K as f64;
+                    let mut x = mean_x;
+                    if n_out > 1 {
+                        rel.select_output(&mut x, out);
+                    }
+                    x[0] = x0;
+                    let (m, lo, hi) = o.band(&x);
+                    (x0, m, lo, hi, o.published.predict(&x))
+                })
+                .collect()
         })
         .collect();
     let ys = o
@@ -77,7 +86,7 @@ fn main_plot<DB: DrawingBackend>(
         .obs
         .iter()
         .map(|o| o.y)
-        .chain(curve.iter().flat_map(|c| [c.1, c.2, c.3, c.4]));
+        .chain(curves.iter().flatten().flat_map(|c| [c.1, c.2, c.3, c.4]));
     let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
         (a.0.min(y), a.1.max(y))
     });
@@ -89,7 +98,16 @@ fn main_plot<DB: DrawingBackend>(
         .skip(1)
         .map(|(j, v)| format!("{} = {:.3} {} (mean)", v.symbol, mean_x[j], v.unit))
         .collect();
-    let caption = if others.is_empty() {
+    let caption = if n_out > 1 {
+        format!(
+            "{} — one curve per output ({})",
+            rel.id(),
+            (0..n_out)
+                .map(|k| rel.output_name(k))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    } else if others.is_empty() {
         format!("{} — {}", rel.id(), rel.citation().equation)
     } else {
         format!("{} — curves at {}", rel.id(), others.join(", "))
@@ -110,14 +128,16 @@ fn main_plot<DB: DrawingBackend>(
         .map_err(|e| e.to_string())?;
     let band_color = RGBColor(120, 160, 230).mix(0.35);
     chart
-        .draw_series(std::iter::once(Polygon::new(
-            curve
-                .iter()
-                .map(|c| (c.0, c.3))
-                .chain(curve.iter().rev().map(|c| (c.0, c.2)))
-                .collect::<Vec<_>>(),
-            band_color.filled(),
-        )))
+        .draw_series(curves.iter().map(|curve| {
+            Polygon::new(
+                curve
+                    .iter()
+                    .map(|c| (c.0, c.3))
+                    .chain(curve.iter().rev().map(|c| (c.0, c.2)))
+                    .collect::<Vec<_>>(),
+                band_color.filled(),
+            )
+        }))
         .map_err(|e| e.to_string())?
         .label("refit 95 % band")
         .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], band_color.filled()));
@@ -131,6 +151,21 @@ fn main_plot<DB: DrawingBackend>(
         .map_err(|e| e.to_string())?
         .label(format!("data (n = {})", o.prepared.obs.len()))
         .legend(|(x, y)| Cross::new((x + 9, y), 4, BLACK));
+    for curve in curves.iter().skip(1) {
+        chart
+            .draw_series(LineSeries::new(
+                curve.iter().map(|c| (c.0, c.1)),
+                BLUE.stroke_width(2),
+            ))
+            .map_err(|e| e.to_string())?;
+        chart
+            .draw_series(LineSeries::new(
+                curve.iter().map(|c| (c.0, c.4)),
+                RED.stroke_width(2),
+            ))
+            .map_err(|e| e.to_string())?;
+    }
+    let curve = &curves[0];
     chart
         .draw_series(LineSeries::new(
             curve.iter().map(|c| (c.0, c.1)),

@@ -10,8 +10,8 @@
 //!
 //! A schedule is a CSV with a `step_length_m` column and optionally `duration_s` (one row per
 //! step). Without `--prototype` the bundled Winter prototype is used; without `--alpha` the
-//! μ-function slopes come from `fits/ko-badler/kb-mu.json` when it exists, else from the built-in values
-//! (the committed fit).
+//! μ-function slopes come from `fits/kb-mu.json` (written by `gaitfit fit`, relation `kb-mu`) when
+//! it exists, else from the built-in values (the committed fit).
 use crate::events::Side;
 use crate::generator::generalize::figure::{
     default_step_duration, metadata, walk_motion, StepPlan,
@@ -44,17 +44,12 @@ pub struct Options {
     /// Write the prototype in use to this JSON file (how `data/prototype_winter.json` is made).
     #[arg(long, value_name = "FILE")]
     pub write_prototype: Option<PathBuf>,
-    /// μ-function slopes α1,α2,α3,α4 in rad/m (default: fits/ko-badler/kb-mu.json, else built in).
+    /// μ-function slopes α1,α2,α3,α4 in rad/m (default: fits/kb-mu.json, else built in).
     #[arg(long, value_delimiter = ',', num_args = 4, value_name = "A1,A2,A3,A4")]
     pub alpha: Option<Vec<f64>>,
-    /// The kb-mu fit to take α from.
-    #[arg(long, value_name = "FILE", default_value = "fits/ko-badler/kb-mu.json")]
+    /// The kb-mu fit to take α from (made by `gaitfit fit --relation kb-mu`).
+    #[arg(long, value_name = "FILE", default_value = "fits/kb-mu.json")]
     pub mu_fit: PathBuf,
-    /// Fit the μ-function slopes (relation `kb-mu`) on these trials tables and write the fit to
-    /// --mu-fit (the regeneration command of `fits/ko-badler/kb-mu.json`, until `gaitfit fit` takes
-    /// relations with several observations per row).
-    #[arg(long, value_name = "CSV", num_args = 1..)]
-    pub fit_mu: Option<Vec<PathBuf>>,
     /// Body height of the figure, m.
     #[arg(long, default_value_t = 1.75)]
     pub height: f64,
@@ -127,33 +122,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             crate::fsio::write_atomic_bytes(out, proto.to_json("(copied)", None).as_bytes())?;
         }
     }
-    if let Some(tables) = &args.fit_mu {
-        let f = crate::relations::kb_mu::fit_tables(tables, &proto, Some(&args.mu_fit))?;
-        for c in &f.coefficients {
-            eprintln!(
-                "{} = {:.5} {}{}{}",
-                c.name,
-                c.value,
-                c.unit,
-                c.std_error
-                    .map(|s| format!(" ± {s:.5}"))
-                    .unwrap_or_default(),
-                c.flag
-                    .as_ref()
-                    .map(|s| format!("  [{s}]"))
-                    .unwrap_or_default()
-            );
-        }
-        eprintln!(
-            "n = {} μ values from {} subjects, rmse {:.2}°; wrote {}",
-            f.n,
-            f.n_subjects,
-            f.rmse.to_degrees(),
-            args.mu_fit.display()
-        );
-    }
     let Some(output) = &args.output else {
-        if args.write_prototype.is_some() || args.fit_mu.is_some() {
+        if args.write_prototype.is_some() {
             return Ok(ExitCode::SUCCESS);
         }
         bail!("give -o/--output FILE (.bvh, .csv or .trc), or --write-prototype");

@@ -48,14 +48,14 @@ pub use walk_data::{AngleSequence, Anthropometry, Moments, PathSequence, TimedSe
 use crate::generator::GenerateError;
 
 /// The μ-function slopes α₁…α₄ (rad/m) used when no fit is given: the values of the committed
-/// `fits/ko-badler/kb-mu.json` (relation `kb-mu`, fitted on the bundled trials tables; α₁ sits on its
+/// `fits/kb-mu.json` (relation `kb-mu`, fitted by `gaitfit fit` on the bundled trials tables; α₁ sits on its
 /// lower bound 0 — measured knees flex *more* at heel strike in longer steps), checked by
 /// `tests/kb_mu_fit.rs`.
 pub const DEFAULT_ALPHA: [f64; 4] = [
-    3.879040089138641e-10,
+    0.0,
     0.5817220095031339,
-    0.9000592970918504,
-    1.364145890380323,
+    0.900059297091851,
+    1.3641458903803227,
 ];
 
 /// A prototype walk W(S*, sl*) with its μ-functions: the generator of every other step.
