@@ -65,7 +65,9 @@ fn main_plot<DB: DrawingBackend>(
     const K: usize = 200;
     // One curve per output (kb-mu's four μ-functions), else one at the other inputs' means.
     let n_out = rel.outputs();
-    let curves: Vec<Vec<(f64, f64, f64, f64, f64)>> = (0..n_out)
+    // (x, refit, band low, band high, published) per abscissa point.
+    type Curve = Vec<(f64, f64, f64, f64, f64)>;
+    let curves: Vec<Curve> = (0..n_out)
         .map(|out| {
             (0..=K)
                 .map(|k| {
