@@ -2,13 +2,19 @@
 //! validate, fit, statistics (no bootstrap, no plots). Fixed seed.
 //!
 //! `cargo bench --bench fit_pipeline`. Set `GAITFIT_BENCH_ROWS` to change the size.
+//!
+//! Before the criterion groups, one pass of every stage is timed and printed twice: wall clock
+//! and the CPU time of the benchmarking thread (`/proc/thread-self/schedstat`, Linux). The
+//! project's machine is shared by several agents on 2 cores, so wall clock there is inflated by
+//! waiting for a core; the CPU time is what the work costs. `GAITFIT_BENCH_STAGES_ONLY=1` stops
+//! after that pass (quick measurements while iterating).
 use criterion::{criterion_group, criterion_main, Criterion};
 use gaitfit::fit::pipeline::{fit_relation, FitOptions};
 use gaitfit::fit::synthetic::{synthetic_rows, SyntheticSpec};
 use gaitfit::ingest::trials::read_trials;
 use gaitfit::relations::{Relation, RunSlV, RunTflightSf, WalkSlSf, WalkTdsSf};
 use std::io::Write;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// A compact trials CSV (only the columns the four relations use, 6 significant digits).
 fn write_csv(path: &std::path::Path, rows: usize) {
@@ -42,6 +48,37 @@ fn write_csv(path: &std::path::Path, rows: usize) {
     }
 }
 
+/// On-CPU time of the current thread, ns (Linux schedstat); 0 elsewhere.
+fn thread_cpu_ns() -> u64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0)
+}
+
+/// Runs `f` once and prints its wall-clock and thread CPU time.
+fn stage<T>(name: &str, total: &mut (f64, f64), f: impl FnOnce() -> T) -> T {
+    let (c0, w0) = (thread_cpu_ns(), Instant::now());
+    let out = f();
+    let (cpu, wall) = (
+        (thread_cpu_ns() - c0) as f64 * 1e-9,
+        w0.elapsed().as_secs_f64(),
+    );
+    total.0 += cpu;
+    total.1 += wall;
+    eprintln!("  {name:<28} cpu {cpu:8.4} s   wall {wall:8.4} s");
+    out
+}
+
+fn rels() -> Vec<Box<dyn Relation>> {
+    vec![
+        Box::new(RunSlV::published()),
+        Box::new(RunTflightSf::published()),
+        Box::new(WalkSlSf::published()),
+        Box::new(WalkTdsSf::published()),
+    ]
+}
+
 fn bench(c: &mut Criterion) {
     let rows: usize = std::env::var("GAITFIT_BENCH_ROWS")
         .ok()
@@ -50,13 +87,26 @@ fn bench(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("trials.csv");
     write_csv(&path, rows);
-    let rels: Vec<Box<dyn Relation>> = vec![
-        Box::new(RunSlV::published()),
-        Box::new(RunTflightSf::published()),
-        Box::new(WalkSlSf::published()),
-        Box::new(WalkTdsSf::published()),
-    ];
+    let rels = rels();
     let opts = FitOptions::default();
+
+    eprintln!("fit_pipeline stages, {rows} rows (one pass):");
+    let mut total = (0.0, 0.0);
+    let t = stage("read", &mut total, || read_trials(&path).expect("read"));
+    let tables = [t];
+    for r in &rels {
+        stage(r.id(), &mut total, || {
+            fit_relation(r.as_ref(), &tables, &opts).expect("fit")
+        });
+    }
+    eprintln!(
+        "  {:<28} cpu {:8.4} s   wall {:8.4} s",
+        "total", total.0, total.1
+    );
+    if std::env::var_os("GAITFIT_BENCH_STAGES_ONLY").is_some() {
+        return;
+    }
+
     let mut g = c.benchmark_group("fit_pipeline");
     g.sample_size(10).measurement_time(Duration::from_secs(30));
     g.bench_function(format!("read_{rows}_rows"), |b| {

@@ -13,6 +13,7 @@ fn close(a: f64, b: f64) -> bool {
 #[test]
 fn refitting_bundled_data_reproduces_committed_fits() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut bad: Vec<String> = Vec::new();
     let fits = read_fits_dir(&root.join("fits")).expect("fits/ readable");
     let have_data = std::fs::read_dir(root.join("data"))
         .map(|d| {
@@ -56,14 +57,12 @@ fn refitting_bundled_data_reproduces_committed_fits() {
         assert_eq!(now.coefficients.len(), committed.coefficients.len());
         for (a, b) in now.coefficients.iter().zip(&committed.coefficients) {
             assert_eq!(a.name, b.name);
-            assert!(
-                close(a.value, b.value),
-                "{} {}: {} vs committed {}",
-                committed.relation,
-                a.name,
-                a.value,
-                b.value
-            );
+            if !close(a.value, b.value) {
+                bad.push(format!(
+                    "{} {}: {} vs committed {}",
+                    committed.relation, a.name, a.value, b.value
+                ));
+            }
             assert_eq!(
                 a.held.is_some(),
                 b.held.is_some(),
@@ -78,15 +77,25 @@ fn refitting_bundled_data_reproduces_committed_fits() {
             ("loo_rmse", now.loo_rmse, committed.loo_rmse),
             ("aic", now.aic, committed.aic),
         ] {
-            assert!(
-                close(a, b),
-                "{} {what}: {a} vs committed {b}",
-                committed.relation
-            );
+            if !close(a, b) {
+                bad.push(format!(
+                    "{} {what}: {a} vs committed {b}",
+                    committed.relation
+                ));
+            }
         }
         match (now.loso_rmse, committed.loso_rmse) {
-            (Some(a), Some(b)) => assert!(close(a, b), "{} loso", committed.relation),
+            (Some(a), Some(b)) => {
+                if !close(a, b) {
+                    bad.push(format!("{} loso: {a} vs committed {b}", committed.relation));
+                }
+            }
             (a, b) => assert_eq!(a, b),
         }
     }
+    assert!(
+        bad.is_empty(),
+        "differences from the committed fits:\n{}",
+        bad.join("\n")
+    );
 }

@@ -271,8 +271,9 @@ fn run_tflight_sf_continuous_matches_a_substituted_normal_equation_fit() {
     let cub = |x: f64| (0..4).map(|j| beta[j] * w(x).powi(j as i32)).sum::<f64>();
     let quad = |x: f64| cub(k1) + beta[4] * (w(x) - w1) + beta[5] * (w(x).powi(2) - w1 * w1);
     let r = o.refit.as_ref();
-    for sf in [150.0, 170.0, 179.0, k1, 190.0, 210.0, 229.0] {
-        let want = if sf < k1 { quad(sf) } else { cub(sf) };
+    // Above k2 the model is the plateau cubic(k2).
+    for sf in [150.0, 170.0, 179.0, k1, 190.0, 210.0, 229.0, 240.0] {
+        let want = if sf < k1 { quad(sf) } else { cub(sf.min(k2)) };
         close(r.predict(&[sf]), want, &format!("t_flight({sf})"));
     }
     let jump = o

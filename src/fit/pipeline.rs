@@ -31,7 +31,6 @@
 //! Standard errors of linear coefficients are conditional on the breakpoint estimates (the
 //! usual profile approach); the bootstrap intervals, which refit the breakpoints in every
 //! replicate, include that uncertainty.
-use super::nonlinear::minimize_1d;
 use super::ols::{huber_irls, ols, LinearFit, LinearProblem};
 use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
@@ -43,8 +42,14 @@ use crate::export::coeffs::{
 };
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Observation, ParamKind, Relation};
+use profile::{
+    profile, profile_interval, refit, whole_subjects, Members, Profiler, SortedRows, Source, Subset,
+};
+
+mod profile;
 use crate::units::parse_header;
 use nalgebra::{DMatrix, DVector};
+pub use profile::DISCRETE_MAX_EVALS;
 use std::collections::BTreeMap;
 
 /// Huber tuning constant (95 % efficiency under normal errors).
@@ -390,23 +395,27 @@ fn solve_ne(
         Some(r) => r.iter().for_each(|&i| add(i)),
         None => (0..prep.obs.len()).for_each(&mut add),
     }
-    let mut xtx = DMatrix::<f64>::zeros(nc, nc);
+    let mut xtx = vec![0.0f64; nc * nc];
     for a in 0..nc {
         for b in 0..nc {
             // Entries were accumulated in either triangle depending on column order.
-            let v = if a == b {
+            xtx[a * nc + b] = if a == b {
                 acc[a * nc + a]
             } else {
                 acc[a * nc + b] + acc[b * nc + a]
             };
-            xtx[(a, b)] = v;
         }
     }
-    let xty = DVector::from_vec(aty);
-    // Equilibrate before Cholesky so that badly scaled columns do not fail it.
+    solve_normal(nc, &xtx, &aty, yty)
+}
+
+/// Solves normal equations (`xtx` full `nc × nc` row-major): (coefficients, weighted RSS), or
+/// `None` when the design is singular. Columns are equilibrated before Cholesky so that badly
+/// scaled ones do not fail it.
+fn solve_normal(nc: usize, xtx: &[f64], xty: &[f64], yty: f64) -> Option<(DVector<f64>, f64)> {
     let d: Vec<f64> = (0..nc)
         .map(|j| {
-            let v = xtx[(j, j)];
+            let v = xtx[j * nc + j];
             if v > 0.0 {
                 1.0 / v.sqrt()
             } else {
@@ -414,237 +423,16 @@ fn solve_ne(
             }
         })
         .collect();
-    if d.contains(&0.0) {
+    if d.contains(&0.0) || d.iter().any(|v| !v.is_finite()) {
         return None;
     }
-    let mut s = xtx.clone();
-    for a in 0..nc {
-        for b in 0..nc {
-            s[(a, b)] *= d[a] * d[b];
-        }
-    }
+    let s = DMatrix::from_fn(nc, nc, |a, b| xtx[a * nc + b] * (d[a] * d[b]));
     let rhs = DVector::from_iterator(nc, (0..nc).map(|j| xty[j] * d[j]));
     let chol = s.cholesky()?;
     let z = chol.solve(&rhs);
     let beta = DVector::from_iterator(nc, (0..nc).map(|j| z[j] * d[j]));
-    let rss = (yty - beta.dot(&xty)).max(0.0);
+    let rss = (yty - beta.dot(&DVector::from_column_slice(xty))).max(0.0);
     Some((beta, rss))
-}
-
-/// Above this many rows, breakpoints are first located on a deterministic subsample (every k-th
-/// row) and then refined on all rows within a few grid cells of the subsample's optimum: the
-/// full-data grid scan would cost ~100 passes over the data per breakpoint.
-pub const PROFILE_SUBSAMPLE: usize = 20_000;
-/// Up to this many rows, leave-one-subject-out refits the breakpoints in every fold; above it,
-/// only the linear coefficients (the record's `loso_note` says which).
-pub const LOSO_FULL_REFIT_MAX: usize = PROFILE_SUBSAMPLE;
-/// Grid points of the full-data refinement around the subsample optimum.
-const REFINE_GRID: usize = 6;
-
-/// SplitMix64: a fixed, well-mixed hash of a row index.
-fn splitmix64(mut x: u64) -> u64 {
-    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^ (x >> 31)
-}
-
-/// A 1-D function for argmin's Brent minimiser; NaN is treated as +∞.
-struct OneD<F>(F);
-
-impl<F: Fn(f64) -> f64> argmin::core::CostFunction for OneD<F> {
-    type Param = f64;
-    type Output = f64;
-    fn cost(&self, x: &f64) -> Result<f64, argmin::core::Error> {
-        let v = (self.0)(*x);
-        Ok(if v.is_nan() { f64::INFINITY } else { v })
-    }
-}
-
-/// Minimises `f` on `[lo, hi]` with a short grid and argmin's Brent method (for the full-data
-/// refinement after a subsample search).
-fn refine_1d<F: Fn(f64) -> f64>(f: F, lo: f64, hi: f64, tol: f64) -> Result<f64, FitError> {
-    // Breakpoints need no more than a millionth of their search range.
-    let tol = tol.max((hi - lo).abs() * 1e-5);
-    let grid: Vec<(f64, f64)> = (0..=REFINE_GRID)
-        .map(|k| {
-            let x = lo + (hi - lo) * k as f64 / REFINE_GRID as f64;
-            (x, f(x))
-        })
-        .collect();
-    let (kb, &(xb, fb)) = grid
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
-        .ok_or_else(|| FitError::Optimizer {
-            relation: "profile".into(),
-            message: "empty grid".into(),
-        })?;
-    let a = grid[kb.saturating_sub(1)].0;
-    let b = grid[(kb + 1).min(REFINE_GRID)].0;
-    if b <= a {
-        return Ok(xb);
-    }
-    let solver = argmin::solver::brent::BrentOpt::new(a, b).set_tolerance(f64::EPSILON.sqrt(), tol);
-    let res = argmin::core::Executor::new(OneD(&f), solver)
-        .configure(|st| st.max_iters(200))
-        .timer(false)
-        .run()
-        .map_err(|e| FitError::Optimizer {
-            relation: "profile".into(),
-            message: e.to_string(),
-        })?;
-    let xr = argmin::core::State::get_best_param(res.state())
-        .copied()
-        .unwrap_or(xb);
-    Ok(if f(xr) <= fb { xr } else { xb })
-}
-
-/// Profiles the free breakpoints (coordinate descent), returning the updated parameters.
-fn profile(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p0: &[f64],
-    search: &[Option<(f64, f64)>],
-    prep: &Prepared,
-    rows: Option<&[usize]>,
-    subj_map: Option<&[usize]>,
-) -> Result<Vec<f64>, FitError> {
-    profile_with(rel, lay, p0, search, prep, rows, subj_map, true)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn profile_with(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p0: &[f64],
-    search: &[Option<(f64, f64)>],
-    prep: &Prepared,
-    rows: Option<&[usize]>,
-    subj_map: Option<&[usize]>,
-    allow_subsample: bool,
-) -> Result<Vec<f64>, FitError> {
-    let bps: Vec<usize> = (0..p0.len())
-        .filter(|&i| lay.free[i] && rel.parameters()[i].kind == ParamKind::Breakpoint)
-        .collect();
-    let mut p = p0.to_vec();
-    if bps.is_empty() {
-        return Ok(p);
-    }
-    let n = rows.map_or(prep.obs.len(), |r| r.len());
-    // A fixed pseudo-random subsample (a hash of the row index, so periodic row orders such as
-    // subjects taking turns cannot alias into a one-subject sample).
-    let sub: Option<Vec<usize>> = (allow_subsample && n > PROFILE_SUBSAMPLE).then(|| {
-        let k = n.div_ceil(PROFILE_SUBSAMPLE) as u64;
-        let keep = |i: usize| splitmix64(i as u64) % k == 0;
-        match rows {
-            Some(r) => r.iter().copied().filter(|&i| keep(i)).collect(),
-            None => (0..n).filter(|&i| keep(i)).collect(),
-        }
-    });
-    let max_rounds = if bps.len() > 1 { 4 } else { 1 };
-    // Coordinate descent with a full search per breakpoint, on the subsample when there is one.
-    let search_rows: Option<&[usize]> = sub.as_deref().or(rows);
-    let mut sub_ok = true;
-    for _ in 0..max_rounds {
-        let mut moved = 0.0f64;
-        for &i in &bps {
-            let Some((lo, hi)) = search[i] else { continue };
-            let tol = (hi - lo).abs() * 1e-7;
-            let f = |t: f64| {
-                let mut q = p.clone();
-                q[i] = t;
-                solve_ne(rel, lay, &q, prep, search_rows, subj_map).map_or(f64::INFINITY, |r| r.1)
-            };
-            let t = match minimize_1d(f, lo, hi, tol) {
-                Ok((t, _)) => t,
-                // The subsample could not be fitted (e.g. too few subjects in it).
-                Err(_) if sub.is_some() => {
-                    sub_ok = false;
-                    break;
-                }
-                Err(e) => return Err(e),
-            };
-            moved = moved.max((t - p[i]).abs() / (hi - lo).abs().max(f64::MIN_POSITIVE));
-            p[i] = t;
-        }
-        if !sub_ok || moved < 1e-6 {
-            break;
-        }
-    }
-    if sub.is_some() {
-        if !sub_ok {
-            return profile_with(rel, lay, p0, search, prep, rows, subj_map, false);
-        }
-        // Refine on all rows within a few grid cells of the subsample's optimum.
-        for _ in 0..max_rounds.min(2) {
-            for &i in &bps {
-                let Some((lo, hi)) = search[i] else { continue };
-                let tol = (hi - lo).abs() * 1e-7;
-                let h = 4.0 * (hi - lo) / 64.0;
-                let f = |t: f64| {
-                    let mut q = p.clone();
-                    q[i] = t;
-                    solve_ne(rel, lay, &q, prep, rows, subj_map).map_or(f64::INFINITY, |r| r.1)
-                };
-                p[i] = refine_1d(f, (p[i] - h).max(lo), (p[i] + h).min(hi), tol)?;
-            }
-        }
-    }
-    Ok(p)
-}
-
-/// Maps subject ids of a row subset to dense 0..S indices.
-fn dense_subjects(prep: &Prepared, rows: &[usize]) -> (Vec<usize>, usize) {
-    let mut map = vec![usize::MAX; prep.subjects.len()];
-    let mut n = 0;
-    for &i in rows {
-        let s = prep.subject[i];
-        if map[s] == usize::MAX {
-            map[s] = n;
-            n += 1;
-        }
-    }
-    (map, n)
-}
-
-/// Refits everything on a subset of rows (cross-validation, bootstrap): returns the global
-/// coefficient vector, or `None` if the subset cannot be fitted.
-fn refit_subset(
-    rel: &dyn Relation,
-    free: &[bool],
-    p_start: &[f64],
-    prep: &Prepared,
-    rows: &[usize],
-    refit_breakpoints: bool,
-) -> Option<Vec<f64>> {
-    let (map, n_subj) = dense_subjects(prep, rows);
-    let sub_obs: Vec<Observation> = rows.iter().map(|&i| prep.obs[i]).collect();
-    let plan = rel.plan(&sub_obs);
-    let mut free = free.to_vec();
-    let mut search = plan.search.clone();
-    for i in 0..free.len() {
-        if rel.parameters()[i].kind == ParamKind::Breakpoint
-            && (!free[i] || search[i].is_none() || !refit_breakpoints)
-        {
-            free[i] = false;
-            search[i] = None;
-        }
-    }
-    let lay = Layout::new(rel, free, n_subj);
-    let p = profile(rel, &lay, p_start, &search, prep, Some(rows), Some(&map)).ok()?;
-    let (beta, _) = solve_ne(rel, &lay, &p, prep, Some(rows), Some(&map))?;
-    let (g, shift) = lay.output_map(rel, &p);
-    let out = &g * &beta + &shift;
-    let mut full = p.clone();
-    let mut j = 0;
-    for (i, s) in rel.parameters().iter().enumerate() {
-        if s.kind == ParamKind::Linear {
-            full[i] = out[j];
-            j += 1;
-        }
-    }
-    Some(full)
 }
 
 /// Everything a fit produced: the record plus what plots need.
@@ -700,7 +488,30 @@ pub fn fit_relation(
     let n = prep.obs.len();
     let specs = rel.parameters();
     let published = rel.values().to_vec();
-    let plan = rel.plan(&prep.obs);
+    // Rows sorted once by the breakpoint key, with prefix sums: every profile evaluation
+    // below (search, F-test, intervals, folds, bootstrap) then costs O(p³), not a pass.
+    let sorted = rel
+        .sorted_profile()
+        .map(|form| SortedRows::new(form, &prep));
+    let all_keys: Vec<f64> = sorted.as_ref().map_or_else(Vec::new, |sr| {
+        sr.distinct_keys(&vec![true; prep.subjects.len()])
+    });
+    let src = match &sorted {
+        Some(sr) => Source::Sorted {
+            sr,
+            members: Members::All,
+            keys: &all_keys,
+        },
+        None => Source::Rows {
+            prep: &prep,
+            rows: None,
+            subj_map: None,
+        },
+    };
+    let plan = match &sorted {
+        Some(sr) => sr.form.plan_sorted(&all_keys),
+        None => rel.plan(&prep.obs),
+    };
     let mut free: Vec<bool> = plan.held.iter().map(|h| h.is_none()).collect();
     let mut held_reason: Vec<Option<String>> = plan.held.clone();
     let n_subj = prep.subjects.len();
@@ -739,7 +550,16 @@ pub fn fit_relation(
     // Profile the breakpoints; drop optional ones the data do not support.
     let mut p = published.clone();
     let mut lay = Layout::new(rel, free.clone(), n_subj);
-    p = profile(rel, &lay, &p, &plan.search, &prep, None, None)?;
+    p = profile(
+        &Profiler {
+            rel,
+            lay: &lay,
+            src,
+        },
+        &p,
+        &plan.search,
+        &mut notes,
+    )?;
     for i in 0..specs.len() {
         if !(free[i] && specs[i].kind == ParamKind::Breakpoint) {
             continue;
@@ -747,10 +567,22 @@ pub fn fit_relation(
         let Some(null) = rel.breakpoint_null(i) else {
             continue;
         };
-        let rss1 = solve_ne(rel, &lay, &p, &prep, None, None).map_or(f64::NAN, |r| r.1);
+        let rss1 = Profiler {
+            rel,
+            lay: &lay,
+            src,
+        }
+        .solve(&p)
+        .map_or(f64::NAN, |r| r.1);
         let mut q = p.clone();
         q[i] = null;
-        let rss0 = solve_ne(rel, &lay, &q, &prep, None, None).map_or(f64::NAN, |r| r.1);
+        let rss0 = Profiler {
+            rel,
+            lay: &lay,
+            src,
+        }
+        .solve(&q)
+        .map_or(f64::NAN, |r| r.1);
         let df = n as f64 - n_params_max as f64;
         let f = (rss0 - rss1) / (rss1 / df);
         let pval = super::stats::t_two_sided_p(f.max(0.0).sqrt(), df);
@@ -764,7 +596,16 @@ pub fn fit_relation(
             ));
             p[i] = published[i];
             lay = Layout::new(rel, free.clone(), n_subj);
-            p = profile(rel, &lay, &p, &plan.search, &prep, None, None)?;
+            p = profile(
+                &Profiler {
+                    rel,
+                    lay: &lay,
+                    src,
+                },
+                &p,
+                &plan.search,
+                &mut notes,
+            )?;
         }
     }
     // Bounded parameters (Relation::bounds): argmin's bounded fit decides which sit on a bound.
@@ -905,7 +746,18 @@ pub fn fit_relation(
                 (p[i], None, [None, None])
             }
         } else if free[i] {
-            let (lo, hi) = profile_interval(rel, &lay, &p, i, &plan.search, &prep, df, tq)?;
+            let (lo, hi) = profile_interval(
+                &Profiler {
+                    rel,
+                    lay: &lay,
+                    src,
+                },
+                &p,
+                i,
+                &plan.search,
+                df,
+                tq,
+            );
             let se = match (lo, hi) {
                 (Some(a), Some(b)) => Some((b - a) / (2.0 * tq)),
                 _ => None,
@@ -989,33 +841,44 @@ pub fn fit_relation(
 
     // Leave-one-subject-out.
     let (loso_rmse, loso_note) = if n_subj >= 3 {
-        let groups = prep.subject.clone();
-        let refit_bp = n <= LOSO_FULL_REFIT_MAX;
-        let res = leave_one_group_out(&groups, |train, test| {
-            let q = refit_subset(rel, &free, &p, &prep, train, refit_bp)?;
-            Some(
-                test.iter()
-                    .map(|&i| (prep.obs[i].y - rel.predict_with(&q, 0.0, &prep.obs[i].x)).powi(2))
-                    .collect::<Vec<f64>>(),
-            )
-        });
+        let sq_err = |q: &[f64], i: usize| {
+            let o = &prep.obs[i];
+            (o.y - rel.predict_with(q, 0.0, &o.x)).powi(2)
+        };
+        let res: Vec<Vec<f64>> = match &sorted {
+            // Folds are subject multisets: no pass over the training rows.
+            Some(sr) => {
+                let mut rows_of = vec![Vec::new(); n_subj];
+                for (i, &s) in prep.subject.iter().enumerate() {
+                    rows_of[s].push(i);
+                }
+                use rayon::prelude::*;
+                (0..n_subj)
+                    .into_par_iter()
+                    .map(|s| {
+                        let fold = Subset::Subjects(sr, Members::AllBut(s));
+                        let q = refit(rel, &free, &p, fold)?;
+                        Some(rows_of[s].iter().map(|&i| sq_err(&q, i)).collect())
+                    })
+                    .collect::<Vec<Option<Vec<f64>>>>()
+                    .into_iter()
+                    .flatten()
+                    .collect()
+            }
+            None => leave_one_group_out(&prep.subject, |train, test| {
+                let q = refit(rel, &free, &p, Subset::Rows(&prep, train))?;
+                Some(test.iter().map(|&i| sq_err(&q, i)).collect::<Vec<f64>>())
+            }),
+        };
         let folds = res.len();
         let sq: Vec<f64> = res.into_iter().flatten().collect();
         if folds == n_subj && !sq.is_empty() {
             (
                 Some((sq.iter().sum::<f64>() / sq.len() as f64).sqrt()),
-                if refit_bp || n_bp == 0 {
-                    format!(
-                        "{n_subj} folds; each subject predicted (level 0) from a full refit, \
-                         breakpoints included, on the others"
-                    )
-                } else {
-                    format!(
-                        "{n_subj} folds; each subject predicted (level 0) from a refit of the \
-                         linear coefficients on the others, breakpoints held at the all-subject \
-                         estimate (more than {LOSO_FULL_REFIT_MAX} rows)"
-                    )
-                },
+                format!(
+                    "{n_subj} folds; each subject predicted (level 0) from a full refit, \
+                     breakpoints included, on the others"
+                ),
             )
         } else {
             (
@@ -1111,7 +974,12 @@ pub fn fit_relation(
         let groups = prep.subject.clone();
         let idx_free: Vec<usize> = (0..specs.len()).filter(|&i| free[i]).collect();
         let summary = bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
-            let q = refit_subset(rel, &free, &p, &prep, rows, true)?;
+            let q = match (&sorted, whole_subjects(&prep, rows)) {
+                (Some(sr), Some(m)) => {
+                    refit(rel, &free, &p, Subset::Subjects(sr, Members::List(&m)))
+                }
+                _ => refit(rel, &free, &p, Subset::Rows(&prep, rows)),
+            }?;
             Some(idx_free.iter().map(|&i| q[i]).collect())
         });
         for (k, &i) in idx_free.iter().enumerate() {
@@ -1272,65 +1140,6 @@ pub fn fit_relation(
         cov: cov_beta,
         df,
     })
-}
-
-/// The profile-likelihood interval of breakpoint `i`: the values where
-/// RSS(θ) = RSS_min·(1 + F(1, df; 0.95)/df), searched within the bracket; `None` = open.
-#[allow(clippy::too_many_arguments)]
-fn profile_interval(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p: &[f64],
-    i: usize,
-    search: &[Option<(f64, f64)>],
-    prep: &Prepared,
-    df: f64,
-    tq: f64,
-) -> Result<(Option<f64>, Option<f64>), FitError> {
-    let Some((lo, hi)) = search[i] else {
-        return Ok((None, None));
-    };
-    let rss = |t: f64| {
-        let mut q = p.to_vec();
-        q[i] = t;
-        solve_ne(rel, lay, &q, prep, None, None).map_or(f64::INFINITY, |r| r.1)
-    };
-    let rmin = rss(p[i]);
-    let thr = rmin * (1.0 + tq * tq / df);
-    // Step outward geometrically (narrow intervals on large data are found in a few steps),
-    // then bisect to 0.1 % of the half-width.
-    let find = |end: f64| -> Option<f64> {
-        let span = end - p[i];
-        if span == 0.0 {
-            return None;
-        }
-        let mut inside = p[i];
-        let mut frac: f64 = 1e-4;
-        loop {
-            let t = p[i] + span * frac.min(1.0);
-            if rss(t) > thr {
-                let (mut a, mut b) = (inside, t);
-                for _ in 0..40 {
-                    if (b - a).abs() <= 1e-3 * (b - p[i]).abs() {
-                        break;
-                    }
-                    let m = 0.5 * (a + b);
-                    if rss(m) > thr {
-                        b = m;
-                    } else {
-                        a = m;
-                    }
-                }
-                return Some(0.5 * (a + b));
-            }
-            if frac >= 1.0 {
-                return None;
-            }
-            inside = t;
-            frac *= 2.0;
-        }
-    };
-    Ok((find(lo), find(hi)))
 }
 
 /// Reads raw measured files (C3D, TRC + forces, treadmill GRF, …) into per-step rows: the hook

@@ -216,6 +216,207 @@ pub struct Plan {
     pub search: Vec<Option<(f64, f64)>>,
 }
 
+/// Maximum number of per-row features of a [`SortedProfile`].
+pub const MAX_PROFILE_FEATURES: usize = 16;
+
+/// Sums of a [`SortedProfile`]'s per-row features (unused slots 0).
+pub type FeatureSums = [f64; MAX_PROFILE_FEATURES];
+
+/// Centre and half-width of the breakpoint key over the rows being fitted: polynomial relations
+/// compute their features in powers of (key − c)/half_width about centres c near the rows, so
+/// that the moments stay well conditioned (a cubic in sf ≈ 200 is not, raw).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyScale {
+    /// Middle of the key range.
+    pub centre: f64,
+    /// Half the key range (1 when the range is empty).
+    pub half_width: f64,
+}
+
+impl KeyScale {
+    /// The scale of keys spanning `[lo, hi]`.
+    pub fn of_range(lo: f64, hi: f64) -> KeyScale {
+        let half = 0.5 * (hi - lo);
+        KeyScale {
+            centre: 0.5 * (lo + hi),
+            half_width: if half > 0.0 && half.is_finite() {
+                half
+            } else {
+                1.0
+            },
+        }
+    }
+    /// ω of a key about `centre`.
+    #[inline]
+    pub fn omega(&self, key: f64, centre: f64) -> f64 {
+        (key - centre) / self.half_width
+    }
+}
+
+/// An interval of the breakpoint key: from `lo` to `hi`, each end included or not (±∞ for an
+/// open end).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyRange {
+    /// Lower end.
+    pub lo: f64,
+    /// Whether `lo` itself belongs to the interval.
+    pub lo_inclusive: bool,
+    /// Upper end.
+    pub hi: f64,
+    /// Whether `hi` itself belongs to the interval.
+    pub hi_inclusive: bool,
+}
+
+impl KeyRange {
+    /// Keys `< t` (`≤ t` when `inclusive`).
+    pub fn below(t: f64, inclusive: bool) -> KeyRange {
+        KeyRange {
+            lo: f64::NEG_INFINITY,
+            lo_inclusive: true,
+            hi: t,
+            hi_inclusive: inclusive,
+        }
+    }
+    /// Keys `> t` (`≥ t` when `inclusive`).
+    pub fn above(t: f64, inclusive: bool) -> KeyRange {
+        KeyRange {
+            lo: t,
+            lo_inclusive: inclusive,
+            hi: f64::INFINITY,
+            hi_inclusive: true,
+        }
+    }
+    /// Keys from `lo` to `hi`, both included.
+    pub fn closed(lo: f64, hi: f64) -> KeyRange {
+        KeyRange {
+            lo,
+            lo_inclusive: true,
+            hi,
+            hi_inclusive: true,
+        }
+    }
+    /// Whether `key` lies in the interval.
+    pub fn contains(&self, key: f64) -> bool {
+        (key > self.lo || (self.lo_inclusive && key == self.lo))
+            && (key < self.hi || (self.hi_inclusive && key == self.hi))
+    }
+}
+
+/// Weighted sums of a relation's per-row features over the rows whose breakpoint key lies in
+/// an interval, provided by the fit pipeline from a tree over the rows sorted by key (a query
+/// costs O(log n), not a pass over the data).
+pub trait KeySums {
+    /// Sums over the rows with key in `range`, the features taken about `centre` (see
+    /// [`SortedProfile::features`]).
+    fn range(&self, range: KeyRange, centre: f64) -> FeatureSums;
+}
+
+/// The normal equations XᵀWX·β = XᵀWy of some rows in a relation's fitting basis (the columns
+/// of [`Relation::basis`], the response net of its offset).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NormalEquations {
+    /// Number of basis columns.
+    pub nb: usize,
+    /// XᵀWX, `nb × nb`, row-major, both triangles filled.
+    pub xtx: Vec<f64>,
+    /// XᵀWy, `nb`.
+    pub xty: Vec<f64>,
+    /// yᵀWy.
+    pub yty: f64,
+}
+
+impl NormalEquations {
+    /// All zero, `nb` columns.
+    pub fn zeros(nb: usize) -> NormalEquations {
+        NormalEquations {
+            nb,
+            xtx: vec![0.0; nb * nb],
+            xty: vec![0.0; nb],
+            yty: 0.0,
+        }
+    }
+
+    /// From the normal equations of a relation's raw linear basis (all its linear parameters,
+    /// [`Relation::raw_basis`]) by moving the held ones (`free[j]` false, value `held[j]`) into
+    /// the offset: the default basis of [`Relation::basis`].
+    pub fn hold_raw(raw: &NormalEquations, free: &[bool], held: &[f64]) -> NormalEquations {
+        let m = raw.nb;
+        let idx: Vec<usize> = (0..m).filter(|&j| free[j]).collect();
+        let hv: Vec<f64> = (0..m)
+            .map(|j| if free[j] { 0.0 } else { held[j] })
+            .collect();
+        let g = |a: usize, b: usize| raw.xtx[a * m + b];
+        let mut out = NormalEquations::zeros(idx.len());
+        let nb = idx.len();
+        for (a, &ia) in idx.iter().enumerate() {
+            let gh: f64 = (0..m).map(|b| g(ia, b) * hv[b]).sum();
+            out.xty[a] = raw.xty[ia] - gh;
+            for (b, &ib) in idx.iter().enumerate() {
+                out.xtx[a * nb + b] = g(ia, ib);
+            }
+        }
+        let hh: f64 = (0..m)
+            .map(|a| hv[a] * (0..m).map(|b| g(a, b) * hv[b]).sum::<f64>())
+            .sum();
+        let hy: f64 = (0..m).map(|a| hv[a] * raw.xty[a]).sum();
+        out.yty = raw.yty - 2.0 * hy + hh;
+        out
+    }
+}
+
+/// The fast profile of a relation with breakpoints (optional, [`Relation::sorted_profile`]).
+///
+/// Profiling a breakpoint refits the linear coefficients at many trial values; done naively
+/// that is a pass over the data per trial value. A relation whose breakpoints all split the
+/// rows by one scalar *key* (the speed normalised by height, the step frequency), and whose
+/// design row within each piece is a fixed linear function of a few per-row *features*, can
+/// instead give the normal equations of any trial value from sums of those features over key
+/// ranges: the pipeline sorts the rows by key once, keeps prefix sums per subject, and every
+/// evaluation costs a few binary searches and an O(p³) solve, independent of the row count.
+pub trait SortedProfile: Sync {
+    /// The scalar input the breakpoints split the rows by.
+    fn key(&self, x: &[f64]) -> f64;
+    /// Number of features per row (≤ [`MAX_PROFILE_FEATURES`]).
+    fn n_features(&self) -> usize;
+    /// The features of one observation about `centre` (a key value; features that depend on
+    /// the key are taken in ω = (key − centre)/`scale.half_width`), unweighted: the pipeline
+    /// multiplies them by the row's weight before summing.
+    fn features(&self, scale: &KeyScale, centre: f64, o: &Observation, out: &mut [f64]);
+    /// Re-centres feature sums taken about `from` to sums about `to`. The pipeline keeps sums
+    /// about the centre of each node of its tree and shifts them only within the queried
+    /// interval, so polynomial moments of a narrow piece keep their digits (a prefix sum about
+    /// one global centre would lose them to cancellation). The default suits features that do
+    /// not depend on the centre.
+    fn shift(&self, _scale: &KeyScale, _sums: &mut FeatureSums, _from: f64, _to: f64) {}
+    /// The normal equations in the basis of [`Relation::basis`] (with `free`) at the
+    /// coefficients `p` (breakpoints and held values), from feature sums over the rows.
+    /// Must agree with a pass over the rows to rounding.
+    fn normal_equations(
+        &self,
+        p: &[f64],
+        free: &[bool],
+        scale: &KeyScale,
+        sums: &dyn KeySums,
+    ) -> NormalEquations;
+    /// [`Relation::plan`] from the distinct keys of the rows, ascending (the relation's
+    /// `plan` must equal this applied to its observations' keys).
+    fn plan_sorted(&self, keys: &[f64]) -> Plan;
+    /// True when the model depends on breakpoint `i` only through which rows fall on each side
+    /// of it (the residual sum of squares is then constant between adjacent keys, and the
+    /// search runs over those partitions exactly).
+    fn discrete_breakpoint(&self, _i: usize) -> bool {
+        false
+    }
+}
+
+/// The distinct keys of observations, ascending.
+pub fn sorted_keys(form: &dyn SortedProfile, obs: &[Observation]) -> Vec<f64> {
+    let mut u: Vec<f64> = obs.iter().map(|o| form.key(&o.x)).collect();
+    u.sort_by(f64::total_cmp);
+    u.dedup();
+    u
+}
+
 /// A published gait relation (see the module docs).
 ///
 /// Coefficient vectors (`p`) hold the global parameters in [`Relation::parameters`] order;
@@ -389,6 +590,12 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
                 k += 1;
             }
         }
+        None
+    }
+
+    /// The fast profile form, when the relation has one (see [`SortedProfile`]); relations
+    /// with breakpoints should provide it, or every trial value costs a pass over the data.
+    fn sorted_profile(&self) -> Option<&dyn SortedProfile> {
         None
     }
 
@@ -610,4 +817,88 @@ pub fn linear_gradient(r: &dyn Relation, p: &[f64], x: &[f64]) -> Vec<f64> {
         }
     }
     out
+}
+
+/// Test support: a relation's [`SortedProfile::normal_equations`] against a pass over the rows
+/// with [`Relation::basis`].
+#[cfg(test)]
+pub(crate) mod sorted_check {
+    use super::*;
+
+    /// Feature sums by brute force (no sorting, no tree).
+    struct Direct<'a> {
+        form: &'a dyn SortedProfile,
+        scale: KeyScale,
+        obs: &'a [Observation],
+    }
+
+    impl KeySums for Direct<'_> {
+        fn range(&self, range: KeyRange, centre: f64) -> FeatureSums {
+            let mut out = [0.0; MAX_PROFILE_FEATURES];
+            let mut f = [0.0; MAX_PROFILE_FEATURES];
+            for o in self.obs {
+                if range.contains(self.form.key(&o.x)) {
+                    self.form.features(&self.scale, centre, o, &mut f);
+                    out.iter_mut().zip(&f).for_each(|(a, b)| *a += b);
+                }
+            }
+            out
+        }
+    }
+
+    /// Asserts that the sorted normal equations equal the basis rows' to `tol` (relative to
+    /// the Cauchy–Schwarz scale of each entry).
+    pub(crate) fn check(
+        rel: &dyn Relation,
+        obs: &[Observation],
+        p: &[f64],
+        free: &[bool],
+        tol: f64,
+    ) {
+        let form = rel.sorted_profile().expect("sorted form");
+        let (lo, hi) = obs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, o| {
+            let k = form.key(&o.x);
+            (a.0.min(k), a.1.max(k))
+        });
+        let scale = KeyScale::of_range(lo, hi);
+        let ne = form.normal_equations(p, free, &scale, &Direct { form, scale, obs });
+        let nb = rel.basis_len(free);
+        assert_eq!(ne.nb, nb);
+        let mut want = NormalEquations::zeros(nb);
+        let mut phi = [0.0; 16];
+        let mut yy_raw = 0.0;
+        for o in obs {
+            let off = rel.basis(p, free, &o.x, &mut phi[..nb]);
+            let y = o.y - off;
+            yy_raw += o.y * o.y + off * off;
+            want.yty += y * y;
+            for a in 0..nb {
+                want.xty[a] += phi[a] * y;
+                for b in 0..nb {
+                    want.xtx[a * nb + b] += phi[a] * phi[b];
+                }
+            }
+        }
+        let what = format!("{} p={p:?} free={free:?}", rel.id());
+        // Entries of all-but-zero columns carry the rounding of their terms, not of their
+        // value: floor the diagonal at a millionth of the largest.
+        let floor = 1e-6 * (0..nb).map(|a| want.xtx[a * nb + a]).fold(0.0, f64::max);
+        let diag = |a: usize| want.xtx[a * nb + a].max(floor);
+        for a in 0..nb {
+            for b in 0..nb {
+                let sc = (diag(a) * diag(b)).sqrt();
+                let (x, w) = (ne.xtx[a * nb + b], want.xtx[a * nb + b]);
+                assert!((x - w).abs() <= tol * sc, "{what}: xtx[{a},{b}] {x} vs {w}");
+            }
+            let sc = (diag(a) * yy_raw).sqrt();
+            let (x, w) = (ne.xty[a], want.xty[a]);
+            assert!((x - w).abs() <= tol * sc, "{what}: xty[{a}] {x} vs {w}");
+        }
+        assert!(
+            (ne.yty - want.yty).abs() <= tol * yy_raw,
+            "{what}: yty {} vs {}",
+            ne.yty,
+            want.yty
+        );
+    }
 }

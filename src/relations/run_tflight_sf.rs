@@ -31,8 +31,9 @@
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
 use super::{
-    expect_id, Citation, CoefficientSet, Domain, LinearMap, Observation, ParamKind, ParameterSpec,
-    Plan, Rejection, Relation, RelationError, Variable,
+    expect_id, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, KeyRange, KeyScale,
+    KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection,
+    Relation, RelationError, SortedProfile, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -232,7 +233,11 @@ struct Layout {
 
 impl Layout {
     fn new(p: &[f64], free: &[bool], continuity: Continuity) -> Layout {
-        let (k1, k2) = (p[7], p[8]);
+        let k1 = p[7];
+        // k2 = +∞ (the model without a plateau, tested against) would make the centring of the
+        // cubic's basis infinite and every basis value NaN; any finite centring spans the same
+        // cubics, so use the published gap.
+        let k2 = if p[8].is_finite() { p[8] } else { k1 + 50.0 };
         let s2 = ((k2 - k1) / 2.0).abs().max(1.0);
         Layout {
             qfree: free[0],
@@ -377,66 +382,10 @@ impl Relation for RunTflightSf {
         Some(d)
     }
     fn plan(&self, obs: &[Observation]) -> Plan {
-        let (k1, k2) = (self.values[7], self.values[8]);
-        let mut d: Vec<f64> = obs.iter().map(|o| o.x[0]).collect();
-        d.sort_by(f64::total_cmp);
-        d.dedup();
-        let below: Vec<f64> = d.iter().copied().filter(|&s| s < k1).collect();
-        let mid: Vec<f64> = d.iter().copied().filter(|&s| s >= k1 && s <= k2).collect();
-        let above: Vec<f64> = d.iter().copied().filter(|&s| s > k2).collect();
-        let mut held: Vec<Option<String>> = vec![None; 9];
-        let mut search = vec![None; 9];
-        if below.len() < MIN_DISTINCT {
-            let why = format!(
-                "held at the published value: {} distinct step frequencies below k1 = {k1} (need {MIN_DISTINCT})",
-                below.len()
-            );
-            for h in held.iter_mut().take(3) {
-                *h = Some(why.clone());
-            }
-        }
-        if mid.len() < MIN_DISTINCT {
-            let why = format!(
-                "held at the published value: {} distinct step frequencies in [k1, k2] = [{k1}, {k2}] (need {MIN_DISTINCT})",
-                mid.len()
-            );
-            for h in held.iter_mut().take(7).skip(3) {
-                *h = Some(why.clone());
-            }
-        }
-        let n = d.len();
-        if held[0].is_none() && held[3].is_none() && n >= 2 * MIN_DISTINCT {
-            let lo = d[MIN_DISTINCT - 1];
-            let hi_candidates: Vec<f64> = d.iter().copied().filter(|&s| s <= k2).collect();
-            let hi = if hi_candidates.len() >= MIN_DISTINCT {
-                hi_candidates[hi_candidates.len() - MIN_DISTINCT]
-            } else {
-                lo
-            };
-            if hi > lo {
-                search[7] = Some((lo, hi));
-            }
-        }
-        if search[7].is_none() {
-            held[7] = Some(
-                "held at the published value: the data do not cover both pieces well enough to place the knot"
-                    .to_string(),
-            );
-        }
-        if held[3].is_none() && above.len() >= 3 && mid.len() >= MIN_DISTINCT {
-            let lo = mid[mid.len().min(MIN_DISTINCT) - 1].max(k1 + 1.0);
-            let hi = d[n - 3];
-            if hi > lo {
-                search[8] = Some((lo, hi));
-            }
-        }
-        if search[8].is_none() {
-            held[8] = Some(format!(
-                "held at the published value: {} distinct step frequencies above k2 = {k2} (need 3) — the plateau is not in the data",
-                above.len()
-            ));
-        }
-        Plan { held, search }
+        self.plan_sorted(&sorted_keys(self, obs))
+    }
+    fn sorted_profile(&self) -> Option<&dyn SortedProfile> {
+        Some(self)
     }
     fn breakpoint_null(&self, i: usize) -> Option<f64> {
         (i == 8).then_some(f64::INFINITY)
@@ -632,6 +581,331 @@ impl Relation for RunTflightSf {
     }
 }
 
+/// A polynomial in ω = (sf − c)/half_width (c: the piece's centre) of degree ≤ 3, coefficients
+/// of 1, ω, ω², ω³: within a piece, every basis column and offset of [`Relation::basis`] is one.
+type Poly = [f64; 4];
+
+fn pc(c: f64) -> Poly {
+    [c, 0.0, 0.0, 0.0]
+}
+fn padd(a: &Poly, b: &Poly) -> Poly {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]]
+}
+fn psub(a: &Poly, b: &Poly) -> Poly {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]]
+}
+fn pscale(a: &Poly, c: f64) -> Poly {
+    [a[0] * c, a[1] * c, a[2] * c, a[3] * c]
+}
+/// Product, truncated at degree 3 (the products used here never exceed it).
+fn pmul(a: &Poly, b: &Poly) -> Poly {
+    let mut r = [0.0; 4];
+    for i in 0..4 {
+        for j in 0..4 - i {
+            r[i + j] += a[i] * b[j];
+        }
+    }
+    r
+}
+fn quad_poly(p: &[f64], s: &Poly) -> Poly {
+    padd(
+        &padd(&pc(p[0]), &pscale(s, p[1])),
+        &pscale(&pmul(s, s), p[2]),
+    )
+}
+fn cubic_poly(p: &[f64], s: &Poly) -> Poly {
+    let s2 = pmul(s, s);
+    padd(
+        &padd(&pc(p[3]), &pscale(s, p[4])),
+        &padd(&pscale(&s2, p[5]), &pscale(&pmul(&s2, s), p[6])),
+    )
+}
+
+/// Feature slots of the sorted profile: ω⁰…ω⁶, ω⁰y…ω³y, y².
+mod feat {
+    pub const Y: usize = 7;
+    pub const YY: usize = 11;
+    pub const N: usize = 12;
+}
+
+impl RunTflightSf {
+    /// The basis columns and offset of the quadratic piece (sf < k1) as polynomials, given u and
+    /// sf as polynomials in ω (mirrors [`Relation::basis`]).
+    fn below_polys(&self, l: &Layout, p: &[f64], u: &Poly, s: &Poly, out: &mut [Poly; 7]) -> Poly {
+        let k1 = p[7];
+        let u1 = (k1 - l.m1) / l.s1;
+        let w1 = (k1 - l.m2) / l.s2;
+        let uu = pmul(u, u);
+        match (l.qfree, l.cfree, l.continuous) {
+            (true, true, false) => {
+                out[0] = pc(1.0);
+                out[1] = *u;
+                out[2] = uu;
+                pc(0.0)
+            }
+            (true, true, true) => {
+                out[0] = pc(1.0);
+                out[1] = pc(w1);
+                out[2] = pc(w1 * w1);
+                out[3] = pc(w1 * w1 * w1);
+                out[4] = psub(u, &pc(u1));
+                out[5] = psub(&uu, &pc(u1 * u1));
+                pc(0.0)
+            }
+            (true, false, true) => {
+                out[0] = psub(u, &pc(u1));
+                out[1] = psub(&uu, &pc(u1 * u1));
+                pc(cubic(p, k1))
+            }
+            (true, false, false) => {
+                out[0] = pc(1.0);
+                out[1] = *u;
+                out[2] = uu;
+                pc(0.0)
+            }
+            (false, _, _) => quad_poly(p, s),
+        }
+    }
+
+    /// The same for the cubic piece, given w and s = min(sf, k2) as polynomials in ω.
+    fn upper_polys(&self, l: &Layout, p: &[f64], w: &Poly, s: &Poly, out: &mut [Poly; 7]) -> Poly {
+        let k1 = p[7];
+        let w1 = (k1 - l.m2) / l.s2;
+        let ww = pmul(w, w);
+        let www = pmul(&ww, w);
+        match (l.qfree, l.cfree, l.continuous) {
+            (true, true, false) => {
+                out[3] = pc(1.0);
+                out[4] = *w;
+                out[5] = ww;
+                out[6] = www;
+                pc(0.0)
+            }
+            (true, true, true) => {
+                out[0] = pc(1.0);
+                out[1] = *w;
+                out[2] = ww;
+                out[3] = www;
+                pc(0.0)
+            }
+            (false, true, true) => {
+                out[0] = psub(w, &pc(w1));
+                out[1] = psub(&ww, &pc(w1 * w1));
+                out[2] = psub(&www, &pc(w1 * w1 * w1));
+                pc(quad(p, k1))
+            }
+            (false, true, false) => {
+                out[0] = pc(1.0);
+                out[1] = *w;
+                out[2] = ww;
+                out[3] = www;
+                pc(0.0)
+            }
+            (_, false, _) => cubic_poly(p, s),
+        }
+    }
+}
+
+/// Adds the normal equations of the rows summarised by `f` (a piece) whose basis columns and
+/// offset are the polynomials `cols`, `off` in ω.
+fn add_piece(ne: &mut NormalEquations, f: &FeatureSums, cols: &[Poly], off: &Poly) {
+    if f[0] == 0.0 {
+        // No rows (their polynomials may not even be finite, e.g. at k2 = +∞).
+        return;
+    }
+    let m = |i: usize, j: usize| f[i + j];
+    let my = |i: usize| f[feat::Y + i];
+    let mv = |a: &Poly| -> Poly {
+        let mut r = [0.0; 4];
+        for (i, ri) in r.iter_mut().enumerate() {
+            *ri = (0..4).map(|j| m(i, j) * a[j]).sum();
+        }
+        r
+    };
+    let dot = |a: &Poly, b: &Poly| a.iter().zip(b).map(|(a, b)| a * b).sum::<f64>();
+    let mo = mv(off);
+    let ymy: Poly = [my(0), my(1), my(2), my(3)];
+    let nb = ne.nb;
+    for a in 0..nb {
+        if cols[a] == [0.0; 4] {
+            continue;
+        }
+        let ma = mv(&cols[a]);
+        ne.xty[a] += dot(&cols[a], &ymy) - dot(&cols[a], &mo);
+        for b in 0..nb {
+            if cols[b] != [0.0; 4] {
+                ne.xtx[a * nb + b] += dot(&cols[b], &ma);
+            }
+        }
+    }
+    ne.yty += f[feat::YY] - 2.0 * dot(off, &ymy) + dot(off, &mo);
+}
+
+impl SortedProfile for RunTflightSf {
+    fn key(&self, x: &[f64]) -> f64 {
+        x[0]
+    }
+    fn n_features(&self) -> usize {
+        feat::N
+    }
+    fn features(&self, scale: &KeyScale, centre: f64, o: &Observation, out: &mut [f64]) {
+        let w = scale.omega(o.x[0], centre);
+        let mut pw = 1.0;
+        for v in out.iter_mut().take(7) {
+            *v = pw;
+            pw *= w;
+        }
+        let y = o.y;
+        out[feat::Y] = y;
+        out[feat::Y + 1] = w * y;
+        out[feat::Y + 2] = w * w * y;
+        out[feat::Y + 3] = w * w * w * y;
+        out[feat::YY] = y * y;
+    }
+    fn shift(&self, scale: &KeyScale, f: &mut FeatureSums, from: f64, to: f64) {
+        // (sf − to)/h = ω + d with ω = (sf − from)/h: binomial expansion of the moments.
+        let d = (from - to) / scale.half_width;
+        if d == 0.0 {
+            return;
+        }
+        let mut dp = [1.0; 7];
+        for k in 1..7 {
+            dp[k] = dp[k - 1] * d;
+        }
+        let shifted = |m: &[f64], k: usize| -> f64 {
+            let mut binom = 1.0;
+            let mut acc = 0.0;
+            for j in (0..=k).rev() {
+                // C(k, j) for j = k, k − 1, …: multiply by j/(k − j + 1).
+                acc += binom * dp[k - j] * m[j];
+                binom = binom * j as f64 / (k - j + 1) as f64;
+            }
+            acc
+        };
+        let m: [f64; 7] = [f[0], f[1], f[2], f[3], f[4], f[5], f[6]];
+        for k in (1..7).rev() {
+            f[k] = shifted(&m, k);
+        }
+        let my: [f64; 4] = [f[feat::Y], f[feat::Y + 1], f[feat::Y + 2], f[feat::Y + 3]];
+        for k in (1..4).rev() {
+            f[feat::Y + k] = shifted(&my, k);
+        }
+    }
+    fn normal_equations(
+        &self,
+        p: &[f64],
+        free: &[bool],
+        scale: &KeyScale,
+        sums: &dyn KeySums,
+    ) -> NormalEquations {
+        let l = Layout::new(p, free, self.continuity);
+        let nb = l.nb();
+        let (k1, k2) = (p[7], p[8]);
+        let mut ne = NormalEquations::zeros(nb);
+        let h = scale.half_width;
+        // Each piece's sums are taken about the middle of its rows' key range, so the
+        // polynomials below are well conditioned however narrow the piece.
+        let (dlo, dhi) = (scale.centre - h, scale.centre + h);
+        let centre = |a: f64, b: f64| {
+            let (a, b) = (a.max(dlo), b.min(dhi));
+            if a <= b {
+                0.5 * (a + b)
+            } else {
+                scale.centre
+            }
+        };
+        let sf = |c: f64| [c, h, 0.0, 0.0];
+        let u = |c: f64| [(c - l.m1) / l.s1, h / l.s1, 0.0, 0.0];
+        let w = |c: f64| [(c - l.m2) / l.s2, h / l.s2, 0.0, 0.0];
+        // Pieces: sf < k1 quadratic; k1 ≤ sf ≤ k2 cubic; above both, the cubic at k2.
+        let cb = centre(f64::NEG_INFINITY, k1);
+        let below = sums.range(KeyRange::below(k1, false), cb);
+        let mut cols = [[0.0; 4]; 7];
+        let off = self.below_polys(&l, p, &u(cb), &sf(cb), &mut cols);
+        add_piece(&mut ne, &below, &cols[..nb], &off);
+        let plateau = if k1 <= k2 {
+            let cm = centre(k1, k2);
+            let middle = sums.range(KeyRange::closed(k1, k2), cm);
+            let mut cols = [[0.0; 4]; 7];
+            let off = self.upper_polys(&l, p, &w(cm), &sf(cm), &mut cols);
+            add_piece(&mut ne, &middle, &cols[..nb], &off);
+            sums.range(KeyRange::above(k2, false), scale.centre)
+        } else {
+            sums.range(KeyRange::above(k1, true), scale.centre)
+        };
+        if plateau[0] != 0.0 {
+            let mut cols = [[0.0; 4]; 7];
+            let wk = (k2 - l.m2) / l.s2;
+            let off = self.upper_polys(&l, p, &pc(wk), &pc(k2), &mut cols);
+            add_piece(&mut ne, &plateau, &cols[..nb], &off);
+        }
+        ne
+    }
+    fn plan_sorted(&self, d: &[f64]) -> Plan {
+        let (k1, k2) = (self.values[7], self.values[8]);
+        let below: Vec<f64> = d.iter().copied().filter(|&s| s < k1).collect();
+        let mid: Vec<f64> = d.iter().copied().filter(|&s| s >= k1 && s <= k2).collect();
+        let above: Vec<f64> = d.iter().copied().filter(|&s| s > k2).collect();
+        let mut held: Vec<Option<String>> = vec![None; 9];
+        let mut search = vec![None; 9];
+        if below.len() < MIN_DISTINCT {
+            let why = format!(
+                "held at the published value: {} distinct step frequencies below k1 = {k1} (need {MIN_DISTINCT})",
+                below.len()
+            );
+            for h in held.iter_mut().take(3) {
+                *h = Some(why.clone());
+            }
+        }
+        if mid.len() < MIN_DISTINCT {
+            let why = format!(
+                "held at the published value: {} distinct step frequencies in [k1, k2] = [{k1}, {k2}] (need {MIN_DISTINCT})",
+                mid.len()
+            );
+            for h in held.iter_mut().take(7).skip(3) {
+                *h = Some(why.clone());
+            }
+        }
+        let n = d.len();
+        if held[0].is_none() && held[3].is_none() && n >= 2 * MIN_DISTINCT {
+            let lo = d[MIN_DISTINCT - 1];
+            let hi_candidates: Vec<f64> = d.iter().copied().filter(|&s| s <= k2).collect();
+            let hi = if hi_candidates.len() >= MIN_DISTINCT {
+                hi_candidates[hi_candidates.len() - MIN_DISTINCT]
+            } else {
+                lo
+            };
+            if hi > lo {
+                search[7] = Some((lo, hi));
+            }
+        }
+        if search[7].is_none() {
+            held[7] = Some(
+                "held at the published value: the data do not cover both pieces well enough to place the knot"
+                    .to_string(),
+            );
+        }
+        if held[3].is_none() && above.len() >= 3 && mid.len() >= MIN_DISTINCT {
+            let lo = mid[mid.len().min(MIN_DISTINCT) - 1].max(k1 + 1.0);
+            let hi = d[n - 3];
+            if hi > lo {
+                search[8] = Some((lo, hi));
+            }
+        }
+        if search[8].is_none() {
+            held[8] = Some(format!(
+                "held at the published value: {} distinct step frequencies above k2 = {k2} (need 3) — the plateau is not in the data",
+                above.len()
+            ));
+        }
+        Plan { held, search }
+    }
+    fn discrete_breakpoint(&self, i: usize) -> bool {
+        // Free pieces: k1 only decides which rows each piece fits (no continuity at k1).
+        i == 7 && self.continuity == Continuity::Free
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -690,5 +964,61 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn sorted_normal_equations_match_the_basis_rows() {
+        // Step frequencies 120–260 with repeats, flight times from the published curve.
+        let obs: Vec<Observation> = (0..400)
+            .map(|i| {
+                let sf = 120.0 + (i % 141) as f64 + 0.37 * ((i * 7) % 3) as f64;
+                Observation {
+                    x: [sf, 0.0, 0.0, 0.0],
+                    y: tflight(&RunTflightSf::published().values, sf)
+                        + 0.002 * ((i % 5) as f64 - 2.0),
+                }
+            })
+            .collect();
+        for cont in [Continuity::Free, Continuity::Continuous] {
+            let base = RunTflightSf {
+                continuity: cont,
+                ..RunTflightSf::published()
+            };
+            for (k1, k2) in [
+                (180.0, 230.0),
+                (171.3, 245.0),
+                (205.0, 190.0),
+                (175.0, f64::INFINITY),
+                (180.0, 181.5),
+            ] {
+                let mut p = base.values.clone();
+                p[7] = k1;
+                p[8] = k2;
+                for (qf, cf) in [(true, true), (false, true), (true, false), (false, false)] {
+                    let mut free = vec![true; 9];
+                    for f in free.iter_mut().take(3) {
+                        *f = qf;
+                    }
+                    for f in free.iter_mut().take(7).skip(3) {
+                        *f = cf;
+                    }
+                    crate::relations::sorted_check::check(&base, &obs, &p, &free, 1e-11);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn plan_sorted_is_plan() {
+        let r = RunTflightSf::published();
+        let obs: Vec<Observation> = (0..60)
+            .map(|i| Observation {
+                x: [150.0 + 2.0 * (i % 45) as f64, 0.0, 0.0, 0.0],
+                y: 0.1,
+            })
+            .collect();
+        let keys = crate::relations::sorted_keys(&r, &obs);
+        assert_eq!(r.plan(&obs), r.plan_sorted(&keys));
+        assert!(r.plan(&obs).search[7].is_some() && r.plan(&obs).search[8].is_some());
     }
 }

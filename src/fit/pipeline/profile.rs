@@ -1,0 +1,858 @@
+//! Breakpoint profiles: the residual sum of squares as a function of a breakpoint (the linear
+//! coefficients refitted at every trial value), its minimisation, its likelihood interval, and
+//! the refits of cross-validation and the bootstrap.
+//!
+//! # Sorted prefix sums
+//! Relations with a [`SortedProfile`] give the normal equations at any trial value from sums
+//! of per-row features over ranges of one key (their breakpoints split the rows by it): the
+//! rows are sorted by key **once** (O(n log n)), each subject's weighted features are
+//! prefix-summed (Neumaier-compensated, so a range sum is exact to rounding of the prefix), and
+//! every evaluation costs one binary search per subject and query plus an O(p³) solve. A
+//! subject multiset (a leave-one-subject-out fold, a bootstrap replicate) is a weighted sum of
+//! per-subject prefixes, so folds never touch the rows either. Relations without one fall back
+//! to a pass over the rows per evaluation (exact, slow on large tables).
+//!
+//! # Searches
+//! - A breakpoint whose residual sum of squares varies continuously (a plateau onset, a knot
+//!   with continuity) is minimised by a 64-cell grid scan followed by argmin's Brent method
+//!   ([`minimize_1d`]), on all rows.
+//! - A *discrete* breakpoint ([`SortedProfile::discrete_breakpoint`]: the model depends on it
+//!   only through which rows fall on each side, e.g. the knot between the flight-time paper's
+//!   free pieces) has a step-function profile: any value between two adjacent distinct keys
+//!   gives the same fit. It is minimised **exactly** over those partitions by branch and bound:
+//!   fitting the rows of a key range's complement gives a lower bound for every partition inside
+//!   the range (fewer rows never fit worse), so ranges whose bound exceeds the best partition
+//!   found are discarded and the rest bisected. The estimate is the midpoint of the optimal gap,
+//!   and its interval ends are data keys (where the partition changes).
+//! - Two breakpoints are profiled by coordinate descent.
+use super::{solve_ne, solve_normal, Layout, Prepared};
+use crate::fit::nonlinear::minimize_1d;
+use crate::fit::prec::MIN1D_GRID;
+use crate::fit::FitError;
+use crate::relations::{
+    FeatureSums, KeyRange, KeyScale, KeySums, Observation, ParamKind, Relation, SortedProfile,
+    MAX_PROFILE_FEATURES,
+};
+use nalgebra::DVector;
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Evaluations after which the exact search of a discrete breakpoint stops and keeps the best
+/// partition found (with a note): reached only by a profile that is flat over a great many
+/// partitions (no knot in the data).
+pub const DISCRETE_MAX_EVALS: usize = 20_000;
+/// Partitions walked one by one from the estimate when locating a discrete breakpoint's
+/// interval ends; beyond, the walk doubles its steps and bisects the first crossing.
+const DISCRETE_WALK: usize = 256;
+
+/// Rows per leaf of a [`Tree`]: leaves partly inside a queried interval are summed row by row.
+const LEAF: usize = 8;
+
+/// Rows sorted by key under a binary tree of feature sums: each node holds the weighted sums of
+/// its rows' features about the centre of its keys, so an interval's sums are O(log n) node
+/// sums, each shifted over a distance within the interval (no cancellation), plus at most
+/// 2·[`LEAF`] rows.
+struct Tree {
+    keys: Vec<f64>,
+    /// `(observation, weight)`, in key order.
+    rows: Vec<(Observation, f64)>,
+    /// Leaves, a power of two.
+    size: usize,
+    /// Per node: lowest and highest key (`+∞, −∞` when empty).
+    span: Vec<(f64, f64)>,
+    /// Per node: `k` sums about the node's centre.
+    sums: Vec<f64>,
+}
+
+impl Tree {
+    fn new(
+        form: &dyn SortedProfile,
+        scale: &KeyScale,
+        k: usize,
+        rows: Vec<(f64, Observation, f64)>,
+    ) -> Tree {
+        let n = rows.len();
+        let leaves = n.div_ceil(LEAF).max(1);
+        let size = leaves.next_power_of_two();
+        let mut span = vec![(f64::INFINITY, f64::NEG_INFINITY); 2 * size];
+        let mut sums = vec![0.0; 2 * size * k];
+        let mut f = [0.0; MAX_PROFILE_FEATURES];
+        for l in 0..leaves {
+            let (a, b) = (l * LEAF, ((l + 1) * LEAF).min(n));
+            if a >= b {
+                continue;
+            }
+            let node = size + l;
+            span[node] = (rows[a].0, rows[b - 1].0);
+            let c = 0.5 * (rows[a].0 + rows[b - 1].0);
+            let out = &mut sums[node * k..(node + 1) * k];
+            for (_, o, w) in &rows[a..b] {
+                form.features(scale, c, o, &mut f[..k]);
+                out.iter_mut().zip(&f).for_each(|(s, f)| *s += w * f);
+            }
+        }
+        for i in (1..size).rev() {
+            let (l, r) = (span[2 * i], span[2 * i + 1]);
+            let sp = (l.0.min(r.0), l.1.max(r.1));
+            span[i] = sp;
+            if sp.0 > sp.1 {
+                continue;
+            }
+            let c = 0.5 * (sp.0 + sp.1);
+            let mut acc = [0.0; MAX_PROFILE_FEATURES];
+            for child in [2 * i, 2 * i + 1] {
+                let (lo, hi) = span[child];
+                if lo > hi {
+                    continue;
+                }
+                let mut t = [0.0; MAX_PROFILE_FEATURES];
+                t[..k].copy_from_slice(&sums[child * k..(child + 1) * k]);
+                form.shift(scale, &mut t, 0.5 * (lo + hi), c);
+                acc.iter_mut().zip(&t).for_each(|(a, t)| *a += t);
+            }
+            sums[i * k..(i + 1) * k].copy_from_slice(&acc[..k]);
+        }
+        let (keys, rows): (Vec<f64>, Vec<(Observation, f64)>) =
+            rows.into_iter().map(|(key, o, w)| (key, (o, w))).unzip();
+        Tree {
+            keys,
+            rows,
+            size,
+            span,
+            sums,
+        }
+    }
+
+    /// First row whose key is `≥ t` (`> t` unless `inclusive`).
+    #[inline]
+    fn lower(&self, t: f64, inclusive: bool) -> usize {
+        if inclusive {
+            self.keys.partition_point(|&x| x < t)
+        } else {
+            self.keys.partition_point(|&x| x <= t)
+        }
+    }
+    /// One past the last row whose key is `≤ t` (`< t` unless `inclusive`).
+    #[inline]
+    fn upper(&self, t: f64, inclusive: bool) -> usize {
+        if inclusive {
+            self.keys.partition_point(|&x| x <= t)
+        } else {
+            self.keys.partition_point(|&x| x < t)
+        }
+    }
+
+    /// Adds `mult` × the sums of rows `a..b` about `centre` to `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn add_span(
+        &self,
+        form: &dyn SortedProfile,
+        scale: &KeyScale,
+        k: usize,
+        a: usize,
+        b: usize,
+        centre: f64,
+        mult: f64,
+        out: &mut FeatureSums,
+    ) {
+        if a >= b {
+            return;
+        }
+        let mut f = [0.0; MAX_PROFILE_FEATURES];
+        let mut rows = |a: usize, b: usize, out: &mut FeatureSums| {
+            for (o, w) in &self.rows[a..b] {
+                form.features(scale, centre, o, &mut f[..k]);
+                let m = mult * w;
+                out.iter_mut().zip(&f[..k]).for_each(|(s, f)| *s += m * f);
+            }
+        };
+        let (fa, fb) = (a.div_ceil(LEAF), b / LEAF);
+        if fa >= fb {
+            rows(a, b, out);
+            return;
+        }
+        rows(a, fa * LEAF, out);
+        rows(fb * LEAF, b, out);
+        let node = |i: usize, out: &mut FeatureSums| {
+            let (lo, hi) = self.span[i];
+            if lo > hi {
+                return;
+            }
+            let mut t = [0.0; MAX_PROFILE_FEATURES];
+            t[..k].copy_from_slice(&self.sums[i * k..(i + 1) * k]);
+            form.shift(scale, &mut t, 0.5 * (lo + hi), centre);
+            out.iter_mut()
+                .zip(&t[..k])
+                .for_each(|(s, t)| *s += mult * t);
+        };
+        let (mut l, mut r) = (fa + self.size, fb + self.size);
+        while l < r {
+            if l & 1 == 1 {
+                node(l, out);
+                l += 1;
+            }
+            if r & 1 == 1 {
+                r -= 1;
+                node(r, out);
+            }
+            l /= 2;
+            r /= 2;
+        }
+    }
+}
+
+/// The rows of a fit sorted by the relation's breakpoint key: one tree over all rows and one per
+/// subject (folds subtract a subject from the whole; bootstrap replicates add subjects).
+pub(super) struct SortedRows<'a> {
+    /// The relation's sorted form.
+    pub form: &'a dyn SortedProfile,
+    /// Scale of the key (features are powers of (key − c)/half_width).
+    pub scale: KeyScale,
+    k: usize,
+    all: Tree,
+    /// Subject of each row of `all`, in key order.
+    key_subject: Vec<u32>,
+    subj: Vec<Tree>,
+}
+
+impl<'a> SortedRows<'a> {
+    /// Sorts the prepared rows by key and builds the trees.
+    pub fn new(form: &'a dyn SortedProfile, prep: &Prepared) -> SortedRows<'a> {
+        let mut order: Vec<(f64, u32)> = prep
+            .obs
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (form.key(&o.x), i as u32))
+            .collect();
+        // Ties by row index: the order (and so every rounding) is deterministic.
+        order.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let scale = match (order.first(), order.last()) {
+            (Some(a), Some(b)) => KeyScale::of_range(a.0, b.0),
+            _ => KeyScale::of_range(0.0, 0.0),
+        };
+        let k = form.n_features().min(MAX_PROFILE_FEATURES);
+        let ns = prep.subjects.len();
+        let mut per: Vec<Vec<(f64, Observation, f64)>> = vec![Vec::new(); ns];
+        let mut rows = Vec::with_capacity(order.len());
+        let mut key_subject = Vec::with_capacity(order.len());
+        for &(key, i) in &order {
+            let i = i as usize;
+            let s = prep.subject[i];
+            let r = (key, prep.obs[i], prep.weights[i]);
+            per[s].push(r);
+            rows.push(r);
+            key_subject.push(s as u32);
+        }
+        SortedRows {
+            form,
+            scale,
+            k,
+            all: Tree::new(form, &scale, k, rows),
+            key_subject,
+            subj: per
+                .into_iter()
+                .map(|r| Tree::new(form, &scale, k, r))
+                .collect(),
+        }
+    }
+
+    /// The distinct keys of the rows of the subjects with `include[s]`, ascending.
+    pub fn distinct_keys(&self, include: &[bool]) -> Vec<f64> {
+        let mut out: Vec<f64> = Vec::new();
+        for (&k, &s) in self.all.keys.iter().zip(&self.key_subject) {
+            if include[s as usize] && out.last() != Some(&k) {
+                out.push(k);
+            }
+        }
+        out
+    }
+}
+
+/// Which subjects' rows an evaluation uses.
+#[derive(Clone, Copy)]
+pub(super) enum Members<'b> {
+    /// All of them.
+    All,
+    /// All but one (a leave-one-subject-out fold).
+    AllBut(usize),
+    /// A multiset `(subject, multiplicity)` (a bootstrap replicate), in column order.
+    List(&'b [(usize, f64)]),
+}
+
+impl Members<'_> {
+    /// The subjects with their multiplicities, in column order (`n` subjects in all).
+    fn list(&self, n: usize) -> Vec<(usize, f64)> {
+        match *self {
+            Members::All => (0..n).map(|s| (s, 1.0)).collect(),
+            Members::AllBut(x) => (0..n).filter(|&s| s != x).map(|s| (s, 1.0)).collect(),
+            Members::List(l) => l.to_vec(),
+        }
+    }
+}
+
+/// [`KeySums`] over some subjects' rows, optionally without those with key in `[c1, c2)`.
+struct Query<'b> {
+    sr: &'b SortedRows<'b>,
+    members: Members<'b>,
+    remove: Option<(f64, f64)>,
+}
+
+impl Query<'_> {
+    fn add(&self, tree: &Tree, r: KeyRange, centre: f64, mult: f64, out: &mut FeatureSums) {
+        let sr = self.sr;
+        let a = tree.lower(r.lo, r.lo_inclusive);
+        let b = tree.upper(r.hi, r.hi_inclusive);
+        let span = |a, b, out: &mut FeatureSums| {
+            tree.add_span(sr.form, &sr.scale, sr.k, a, b, centre, mult, out)
+        };
+        match self.remove {
+            None => span(a, b, out),
+            Some((c1, c2)) => {
+                span(a, b.min(tree.lower(c1, true)), out);
+                span(a.max(tree.lower(c2, true)), b, out);
+            }
+        }
+    }
+}
+
+impl KeySums for Query<'_> {
+    fn range(&self, r: KeyRange, centre: f64) -> FeatureSums {
+        let mut out = [0.0; MAX_PROFILE_FEATURES];
+        match self.members {
+            Members::All => self.add(&self.sr.all, r, centre, 1.0, &mut out),
+            Members::AllBut(s) => {
+                self.add(&self.sr.all, r, centre, 1.0, &mut out);
+                self.add(&self.sr.subj[s], r, centre, -1.0, &mut out);
+            }
+            Members::List(l) => {
+                for &(s, m) in l {
+                    self.add(&self.sr.subj[s], r, centre, m, &mut out);
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The normal-equation solve of some subjects' rows from the trees (optionally without the rows
+/// whose key lies in `remove = [c1, c2)`): the same numbers as a pass over those rows, to
+/// rounding.
+fn solve_sorted(
+    sr: &SortedRows,
+    lay: &Layout,
+    p: &[f64],
+    members: Members,
+    remove: Option<(f64, f64)>,
+) -> Option<(DVector<f64>, f64)> {
+    let nc = lay.ncols();
+    let mut xtx = vec![0.0; nc * nc];
+    let mut xty = vec![0.0; nc];
+    let mut yty = 0.0;
+    match lay.subj_col {
+        // Per-subject slope columns: each subject's normal equations land in its own column.
+        Some(sc) => {
+            for (m, (s, mult)) in members.list(sr.subj.len()).into_iter().enumerate() {
+                let one = [(s, 1.0)];
+                let q = Query {
+                    sr,
+                    members: Members::List(&one),
+                    remove,
+                };
+                let ne = sr.form.normal_equations(p, &lay.free, &sr.scale, &q);
+                if ne.nb != lay.nb {
+                    return None;
+                }
+                let col = |j: usize| match j.cmp(&sc) {
+                    std::cmp::Ordering::Equal => lay.nb - 1 + m,
+                    std::cmp::Ordering::Greater => j - 1,
+                    std::cmp::Ordering::Less => j,
+                };
+                for a in 0..ne.nb {
+                    let ca = col(a);
+                    xty[ca] += mult * ne.xty[a];
+                    for b in 0..ne.nb {
+                        xtx[ca * nc + col(b)] += mult * ne.xtx[a * ne.nb + b];
+                    }
+                }
+                yty += mult * ne.yty;
+            }
+        }
+        None => {
+            let q = Query {
+                sr,
+                members,
+                remove,
+            };
+            let ne = sr.form.normal_equations(p, &lay.free, &sr.scale, &q);
+            if ne.nb != nc {
+                return None;
+            }
+            xtx.copy_from_slice(&ne.xtx);
+            xty.copy_from_slice(&ne.xty);
+            yty = ne.yty;
+        }
+    }
+    solve_normal(nc, &xtx, &xty, yty)
+}
+
+/// Where the rows of a profile come from.
+#[derive(Clone, Copy)]
+pub(super) enum Source<'b> {
+    /// A pass over the rows per evaluation (relations without a sorted form).
+    Rows {
+        prep: &'b Prepared,
+        rows: Option<&'b [usize]>,
+        subj_map: Option<&'b [usize]>,
+    },
+    /// Trees over the rows sorted by key; `keys` are the members' rows' distinct keys.
+    Sorted {
+        sr: &'b SortedRows<'b>,
+        members: Members<'b>,
+        keys: &'b [f64],
+    },
+}
+
+/// Evaluates a relation's fit on some rows at trial breakpoints.
+pub(super) struct Profiler<'b> {
+    pub rel: &'b dyn Relation,
+    pub lay: &'b Layout,
+    pub src: Source<'b>,
+}
+
+impl Profiler<'_> {
+    /// Linear coefficients and weighted RSS at `p`, `None` when singular.
+    pub fn solve(&self, p: &[f64]) -> Option<(DVector<f64>, f64)> {
+        match self.src {
+            Source::Rows {
+                prep,
+                rows,
+                subj_map,
+            } => solve_ne(self.rel, self.lay, p, prep, rows, subj_map),
+            Source::Sorted { sr, members, .. } => solve_sorted(sr, self.lay, p, members, None),
+        }
+    }
+
+    /// Weighted RSS at `p` (+∞ when singular).
+    pub fn rss(&self, p: &[f64]) -> f64 {
+        self.solve(p).map_or(f64::INFINITY, |r| r.1)
+    }
+
+    fn rss_at(&self, p: &[f64], i: usize, t: f64) -> f64 {
+        let mut q = p.to_vec();
+        q[i] = t;
+        self.rss(&q)
+    }
+
+    /// The sorted source when breakpoint `i` is discrete.
+    fn discrete(&self, i: usize) -> Option<Discrete<'_>> {
+        match self.src {
+            Source::Sorted { sr, members, keys } if sr.form.discrete_breakpoint(i) => {
+                Some(Discrete {
+                    pr: self,
+                    sr,
+                    members,
+                    keys,
+                    i,
+                })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// A discrete breakpoint's profile over partitions. Partition `j` (1 ≤ j < keys.len()) puts the
+/// rows with key < `keys[j]` below the breakpoint: every value in `(keys[j−1], keys[j]]`.
+struct Discrete<'b> {
+    pr: &'b Profiler<'b>,
+    sr: &'b SortedRows<'b>,
+    members: Members<'b>,
+    keys: &'b [f64],
+    i: usize,
+}
+
+/// An f64 ordered by `total_cmp` (for the heap).
+#[derive(PartialEq)]
+struct Ordered(f64);
+impl Eq for Ordered {}
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Ordered {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+impl Discrete<'_> {
+    /// The breakpoint value representing partition `j`: the middle of its gap.
+    fn value(&self, j: usize) -> f64 {
+        0.5 * (self.keys[j - 1] + self.keys[j])
+    }
+    fn rss(&self, p: &[f64], j: usize) -> f64 {
+        self.pr.rss_at(p, self.i, self.value(j))
+    }
+    /// A lower bound of the RSS of partitions `a..=b`: the fit without the rows whose side
+    /// differs between them (keys in `[keys[a], keys[b])`).
+    fn lower_bound(&self, p: &[f64], a: usize, b: usize) -> f64 {
+        let mut q = p.to_vec();
+        q[self.i] = self.value(a);
+        solve_sorted(
+            self.sr,
+            self.pr.lay,
+            &q,
+            self.members,
+            Some((self.keys[a], self.keys[b])),
+        )
+        // Singular without those rows: no bound.
+        .map_or(0.0, |r| r.1)
+    }
+    /// The partitions whose whole gap lies in `[lo, hi]`.
+    fn candidates(&self, lo: f64, hi: f64) -> Option<(usize, usize)> {
+        let j0 = self.keys.partition_point(|&d| d < lo) + 1;
+        let j1 = self.keys.partition_point(|&d| d <= hi).checked_sub(1)?;
+        (j0 <= j1 && j1 < self.keys.len()).then_some((j0, j1))
+    }
+
+    /// The exact minimum over the partitions in `[lo, hi]` (branch and bound), as a value.
+    fn minimise(&self, p: &[f64], lo: f64, hi: f64, notes: &mut Vec<String>) -> Option<f64> {
+        let (j0, j1) = self.candidates(lo, hi)?;
+        let mut evals = 0usize;
+        let mut best = (f64::INFINITY, j0);
+        let visit = |j: usize, best: &mut (f64, usize), evals: &mut usize| {
+            let r = self.rss(p, j);
+            *evals += 1;
+            // Ties go to the lower partition, so the result does not depend on visit order.
+            if r < best.0 || (r == best.0 && j < best.1) {
+                *best = (r, j);
+            }
+        };
+        let cells = MIN1D_GRID.min(j1 - j0).max(1);
+        let mut grid: Vec<usize> = (0..=cells).map(|c| j0 + (j1 - j0) * c / cells).collect();
+        grid.dedup();
+        for &j in &grid {
+            visit(j, &mut best, &mut evals);
+        }
+        let mut heap: BinaryHeap<Reverse<(Ordered, usize, usize)>> = BinaryHeap::new();
+        let push = |a: usize,
+                    b: usize,
+                    heap: &mut BinaryHeap<Reverse<(Ordered, usize, usize)>>,
+                    best: &mut (f64, usize),
+                    evals: &mut usize| {
+            if a == b {
+                visit(a, best, evals);
+            } else {
+                *evals += 1;
+                heap.push(Reverse((Ordered(self.lower_bound(p, a, b)), a, b)));
+            }
+        };
+        for w in grid.windows(2) {
+            if w[1] > w[0] + 1 {
+                push(w[0] + 1, w[1] - 1, &mut heap, &mut best, &mut evals);
+            }
+        }
+        while let Some(Reverse((Ordered(bound), a, b))) = heap.pop() {
+            // Bounds agree with fits to rounding; a partition better than the best by less than
+            // that is not distinguishable.
+            if bound >= best.0 - 1e-12 * best.0.abs() {
+                break;
+            }
+            if evals >= DISCRETE_MAX_EVALS {
+                notes.push(format!(
+                    "{}: the exact search over partitions stopped after {DISCRETE_MAX_EVALS} \
+                     evaluations (the profile is flat over many partitions); the best partition \
+                     found is reported",
+                    self.pr.rel.parameters()[self.i].name
+                ));
+                break;
+            }
+            let m = a + (b - a) / 2;
+            visit(m, &mut best, &mut evals);
+            if a < m {
+                push(a, m - 1, &mut heap, &mut best, &mut evals);
+            }
+            if m < b {
+                push(m + 1, b, &mut heap, &mut best, &mut evals);
+            }
+        }
+        best.0.is_finite().then(|| self.value(best.1))
+    }
+
+    /// The profile interval's ends: the data keys where the partition's RSS first exceeds
+    /// `thr`, walking out from the estimate; `None` when it stays below within `[lo, hi]`.
+    fn interval(&self, p: &[f64], lo: f64, hi: f64, thr: f64) -> (Option<f64>, Option<f64>) {
+        let Some((j0, j1)) = self.candidates(lo, hi) else {
+            return (None, None);
+        };
+        let est = self.keys.partition_point(|&d| d < p[self.i]).clamp(j0, j1);
+        let above = |j: usize| self.rss(p, j) > thr;
+        // First rejected partition stepping by `dir` from `est` within [j0, j1].
+        let first_out = |down: bool| -> Option<usize> {
+            let step = |j: usize, d: usize| -> Option<usize> {
+                if down {
+                    j.checked_sub(d).filter(|&k| k >= j0)
+                } else {
+                    Some(j + d).filter(|&k| k <= j1)
+                }
+            };
+            let mut inside = est;
+            for _ in 0..DISCRETE_WALK {
+                let j = step(inside, 1)?;
+                if above(j) {
+                    return Some(j);
+                }
+                inside = j;
+            }
+            // Doubling steps, then bisect between the last inside and the first outside.
+            let mut d = 2;
+            loop {
+                let j = match step(inside, d) {
+                    Some(j) => j,
+                    None => {
+                        let end = if down { j0 } else { j1 };
+                        if end == inside || !above(end) {
+                            return None;
+                        }
+                        end
+                    }
+                };
+                if above(j) {
+                    let (mut a, mut b) = (inside, j);
+                    while a.abs_diff(b) > 1 {
+                        let m = if down {
+                            b + (a - b) / 2
+                        } else {
+                            a + (b - a) / 2
+                        };
+                        if above(m) {
+                            b = m;
+                        } else {
+                            a = m;
+                        }
+                    }
+                    return Some(b);
+                }
+                inside = j;
+                d *= 2;
+            }
+        };
+        // Rejected partition j below: accepted values start above keys[j]; above: they end at
+        // keys[j − 1].
+        (
+            first_out(true).map(|j| self.keys[j]),
+            first_out(false).map(|j| self.keys[j - 1]),
+        )
+    }
+}
+
+/// Profiles the free breakpoints of `pr.lay` (coordinate descent), returning the updated
+/// parameters.
+pub(super) fn profile(
+    pr: &Profiler,
+    p0: &[f64],
+    search: &[Option<(f64, f64)>],
+    notes: &mut Vec<String>,
+) -> Result<Vec<f64>, FitError> {
+    let rel = pr.rel;
+    let bps: Vec<usize> = (0..p0.len())
+        .filter(|&i| pr.lay.free[i] && rel.parameters()[i].kind == ParamKind::Breakpoint)
+        .collect();
+    let mut p = p0.to_vec();
+    let max_rounds = if bps.len() > 1 { 4 } else { 1 };
+    for _ in 0..max_rounds {
+        let mut moved = 0.0f64;
+        for &i in &bps {
+            let Some((lo, hi)) = search[i] else { continue };
+            let t = match pr.discrete(i) {
+                Some(d) => d
+                    .minimise(&p, lo, hi, notes)
+                    .ok_or_else(|| FitError::Optimizer {
+                        relation: rel.id().into(),
+                        message: format!(
+                            "no partition of the rows by {} in [{lo}, {hi}] can be fitted",
+                            rel.parameters()[i].name
+                        ),
+                    })?,
+                None => {
+                    let tol = (hi - lo).abs() * 1e-7;
+                    minimize_1d(|t| pr.rss_at(&p, i, t), lo, hi, tol)?.0
+                }
+            };
+            moved = moved.max((t - p[i]).abs() / (hi - lo).abs().max(f64::MIN_POSITIVE));
+            p[i] = t;
+        }
+        if moved < 1e-6 {
+            break;
+        }
+    }
+    Ok(p)
+}
+
+/// The profile-likelihood interval of breakpoint `i`: the values where
+/// RSS(θ) = RSS_min·(1 + F(1, df; 0.95)/df), searched within the bracket; `None` = open.
+pub(super) fn profile_interval(
+    pr: &Profiler,
+    p: &[f64],
+    i: usize,
+    search: &[Option<(f64, f64)>],
+    df: f64,
+    tq: f64,
+) -> (Option<f64>, Option<f64>) {
+    let Some((lo, hi)) = search[i] else {
+        return (None, None);
+    };
+    let rmin = pr.rss(p);
+    let thr = rmin * (1.0 + tq * tq / df);
+    if let Some(d) = pr.discrete(i) {
+        return d.interval(p, lo, hi, thr);
+    }
+    let rss = |t: f64| pr.rss_at(p, i, t);
+    // Step outward geometrically (narrow intervals on large data are found in a few steps),
+    // then bisect to 0.1 % of the half-width.
+    let find = |end: f64| -> Option<f64> {
+        let span = end - p[i];
+        if span == 0.0 {
+            return None;
+        }
+        let mut inside = p[i];
+        let mut frac: f64 = 1e-4;
+        loop {
+            let t = p[i] + span * frac.min(1.0);
+            if rss(t) > thr {
+                let (mut a, mut b) = (inside, t);
+                for _ in 0..40 {
+                    if (b - a).abs() <= 1e-3 * (b - p[i]).abs() {
+                        break;
+                    }
+                    let m = 0.5 * (a + b);
+                    if rss(m) > thr {
+                        b = m;
+                    } else {
+                        a = m;
+                    }
+                }
+                return Some(0.5 * (a + b));
+            }
+            if frac >= 1.0 {
+                return None;
+            }
+            inside = t;
+            frac *= 2.0;
+        }
+    };
+    (find(lo), find(hi))
+}
+
+/// The rows of a refit (cross-validation, bootstrap).
+pub(super) enum Subset<'b> {
+    /// Row indices (relations without a sorted form).
+    Rows(&'b Prepared, &'b [usize]),
+    /// Some subjects' rows.
+    Subjects(&'b SortedRows<'b>, Members<'b>),
+}
+
+/// Maps subject ids of a row subset to dense 0..S indices (order of first appearance).
+fn dense_subjects(prep: &Prepared, rows: &[usize]) -> (Vec<usize>, usize) {
+    let mut map = vec![usize::MAX; prep.subjects.len()];
+    let mut n = 0;
+    for &i in rows {
+        let s = prep.subject[i];
+        if map[s] == usize::MAX {
+            map[s] = n;
+            n += 1;
+        }
+    }
+    (map, n)
+}
+
+/// The subject multiset of a row subset made of whole subjects (a bootstrap sample), in order
+/// of first appearance; `None` when some subject is only partly included.
+pub(super) fn whole_subjects(prep: &Prepared, rows: &[usize]) -> Option<Vec<(usize, f64)>> {
+    let ns = prep.subjects.len();
+    let mut size = vec![0usize; ns];
+    for &s in &prep.subject {
+        size[s] += 1;
+    }
+    let mut count = vec![0usize; ns];
+    let mut order = Vec::new();
+    for &i in rows {
+        let s = prep.subject[i];
+        if count[s] == 0 {
+            order.push(s);
+        }
+        count[s] += 1;
+    }
+    order
+        .into_iter()
+        .map(|s| (count[s] % size[s] == 0).then(|| (s, (count[s] / size[s]) as f64)))
+        .collect()
+}
+
+/// Refits everything (breakpoints included) on a subset: the global coefficient vector, or
+/// `None` if the subset cannot be fitted.
+pub(super) fn refit(
+    rel: &dyn Relation,
+    free: &[bool],
+    p_start: &[f64],
+    subset: Subset,
+) -> Option<Vec<f64>> {
+    let (plan, n_subj, map, keys);
+    match subset {
+        Subset::Rows(prep, rows) => {
+            let (m, n) = dense_subjects(prep, rows);
+            let sub_obs: Vec<Observation> = rows.iter().map(|&i| prep.obs[i]).collect();
+            plan = rel.plan(&sub_obs);
+            (n_subj, map, keys) = (n, m, Vec::new());
+        }
+        Subset::Subjects(sr, members) => {
+            let list = members.list(sr.subj.len());
+            let mut include = vec![false; sr.subj.len()];
+            for &(s, _) in &list {
+                include[s] = true;
+            }
+            keys = sr.distinct_keys(&include);
+            plan = sr.form.plan_sorted(&keys);
+            (n_subj, map) = (list.len(), Vec::new());
+        }
+    }
+    let mut free = free.to_vec();
+    let mut search = plan.search.clone();
+    for i in 0..free.len() {
+        if rel.parameters()[i].kind == ParamKind::Breakpoint && (!free[i] || search[i].is_none()) {
+            free[i] = false;
+            search[i] = None;
+        }
+    }
+    let lay = Layout::new(rel, free, n_subj);
+    let src = match subset {
+        Subset::Rows(prep, rows) => Source::Rows {
+            prep,
+            rows: Some(rows),
+            subj_map: Some(&map),
+        },
+        Subset::Subjects(sr, members) => Source::Sorted {
+            sr,
+            members,
+            keys: &keys,
+        },
+    };
+    let pr = Profiler {
+        rel,
+        lay: &lay,
+        src,
+    };
+    let p = profile(&pr, p_start, &search, &mut Vec::new()).ok()?;
+    let (beta, _) = pr.solve(&p)?;
+    let (g, shift) = lay.output_map(rel, &p);
+    let out = &g * &beta + &shift;
+    let mut full = p.clone();
+    let mut j = 0;
+    for (i, s) in rel.parameters().iter().enumerate() {
+        if s.kind == ParamKind::Linear {
+            full[i] = out[j];
+            j += 1;
+        }
+    }
+    Some(full)
+}
