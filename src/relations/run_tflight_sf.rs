@@ -732,9 +732,9 @@ fn add_piece(ne: &mut NormalEquations, f: &FeatureSums, cols: &[Poly], off: &Pol
         }
         let ma = mv(&cols[a]);
         ne.xty[a] += dot(&cols[a], &ymy) - dot(&cols[a], &mo);
-        for b in 0..nb {
-            if cols[b] != [0.0; 4] {
-                ne.xtx[a * nb + b] += dot(&cols[b], &ma);
+        for (b, cb) in cols.iter().enumerate().take(nb) {
+            if *cb != [0.0; 4] {
+                ne.xtx[a * nb + b] += dot(cb, &ma);
             }
         }
     }
