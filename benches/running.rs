@@ -37,13 +37,15 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("runner");
     let cases: [(&str, RunAttributes, Option<Schedule>); 3] = [
         ("10 s at 12 km/h, 120 fps, defaults", defaults.clone(), None),
-        ("10 s at 12 km/h, 120 fps, toe strike + styled", styled, None),
+        (
+            "10 s at 12 km/h, 120 fps, toe strike + styled",
+            styled,
+            None,
+        ),
         ("8 → 20 km/h then stop, 120 fps", defaults, Some(accelerate)),
     ];
     for (name, attrs, sched) in cases {
-        let p = model
-            .natural(12.0 / 3.6, 0.0, &attrs)
-            .expect("natural run");
+        let p = model.natural(12.0 / 3.6, 0.0, &attrs).expect("natural run");
         let (m, _) = generate_run(&model, p, attrs.clone(), sched.clone(), &opts).expect("run");
         g.throughput(Throughput::Elements(m.len() as u64));
         g.bench_function(name, |b| {
