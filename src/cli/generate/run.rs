@@ -64,10 +64,18 @@ pub struct Args {
     /// Do not stop at the end (by default the run ends standing by --seconds).
     #[arg(long = "no-stop")]
     pub no_stop: bool,
-    /// Also write one row per generated step (side, start, speed, step length, frequency,
-    /// flight time and height, pelvis at toe off and heel strike, recoveries) to this CSV.
+    /// Also write the generated steps to this CSV in the trials schema that `gaitfit fit`
+    /// reads (subject, gait, side, time, speed, step length, frequency, stance and flight time,
+    /// flight height, body and leg length; the final stop is not a step).
     #[arg(long = "steps")]
     pub steps_csv: Option<PathBuf>,
+    /// Subject name written to the --steps table (default `runner-<height>m`).
+    #[arg(long)]
+    pub subject: Option<String>,
+    /// Also write the generator's plan of each step (kind, start, duration, parameters, flight
+    /// case, pelvis at toe off and heel strike, p, recoveries) to this CSV.
+    #[arg(long = "plan")]
+    pub plan_csv: Option<PathBuf>,
     /// Output file: `.bvh`, `.csv` (plus `<stem>_events.csv`) or `.trc`.
     #[arg(short = 'o', long)]
     pub output: PathBuf,
@@ -196,7 +204,21 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     let (motion, report) = generate_run(&model, params, attrs, schedule, &opts)?;
     crate::export::motion::write(&motion, &args.output)?;
     if let Some(path) = &args.steps_csv {
-        write_steps(path, &report)?;
+        let subject = args
+            .subject
+            .clone()
+            .unwrap_or_else(|| format!("runner-{height:.2}m"));
+        let trial = args
+            .output
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let leg = model.skeleton.anthropometry().hip_height_m();
+        crate::ingest::trials::write_trials(path, &report.step_rows(&subject, &trial, Some(leg)))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.plan_csv {
+        write_plan(path, &report)?;
     }
     println!(
         "gaitfit generate run: {} frames at {} fps ({:.2} s), {} steps, relations {}",
@@ -206,8 +228,18 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         report.steps.len(),
         report.relations
     );
+    let first = report.steps.first();
     println!(
-        "  start: v {:.3} m/s ({:.1} km/h), sl {:.3} m, sf {:.1} steps/min, t_flight {:.3} s, H {:.4} m, level {}",
+        "  first step: v {:.3} m/s ({:.1} km/h), sl {:.3} m, sf {:.1} steps/min, t_flight {:.3} s, H {:.4} m",
+        first.map_or(0.0, |s| s.speed),
+        first.map_or(0.0, |s| s.speed * 3.6),
+        first.map_or(0.0, |s| s.step_length),
+        first.map_or(0.0, |s| s.step_freq * 60.0),
+        first.map_or(0.0, |s| s.report.t_flight),
+        first.map_or(0.0, |s| s.report.flight_height),
+    );
+    println!(
+        "  requested: v {:.3} m/s ({:.1} km/h), sl {:.3} m, sf {:.1} steps/min, t_flight {:.3} s, H {:.4} m, level {}",
         params.speed,
         params.speed * 3.6,
         params.step_length,
@@ -223,7 +255,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn write_steps(
+fn write_plan(
     path: &std::path::Path,
     report: &crate::generator::running::RunReport,
 ) -> anyhow::Result<()> {

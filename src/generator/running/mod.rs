@@ -73,6 +73,42 @@ pub struct RunReport {
     pub notes: Vec<String>,
 }
 
+impl RunReport {
+    /// The generated running steps (the start and every running step; the final stop is not a
+    /// step of the relations) as rows of the trials schema that `gaitfit fit` reads
+    /// ([`crate::ingest::trials::write_trials`]): the commanded speed, step length, step
+    /// frequency, stance and flight time and eq. 3's H of each step, with `subject` and `trial`
+    /// naming them and the figure's body height (and `leg_length_m`, if given).
+    pub fn step_rows(
+        &self,
+        subject: &str,
+        trial: &str,
+        leg_length_m: Option<f64>,
+    ) -> Vec<crate::ingest::trials::StepRow> {
+        self.steps
+            .iter()
+            .filter(|s| s.kind != state::StepKind::Stop)
+            .map(|s| crate::ingest::trials::StepRow {
+                subject: subject.to_string(),
+                gait: Some(Gait::Run),
+                side: Some(s.side),
+                source: format!("gaitfit generate run (relations: {})", self.relations),
+                trial: trial.to_string(),
+                time_s: Some(s.start_s),
+                speed_m_per_s: Some(s.speed),
+                step_length_m: Some(s.step_length),
+                step_freq_hz: Some(s.step_freq),
+                stance_time_s: Some(s.report.t_stance),
+                flight_time_s: Some(s.report.t_flight),
+                flight_height_m: Some(s.report.flight_height),
+                body_height_m: Some(self.initial.body_height),
+                leg_length_m,
+                ..Default::default()
+            })
+            .collect()
+    }
+}
+
 /// Estimated time from a stop request to standing still, s.
 fn stop_duration_estimate(params: &RunParams) -> f64 {
     let fr = (params.body_height / 1.8).sqrt();
