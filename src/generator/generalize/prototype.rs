@@ -64,6 +64,10 @@ pub struct SagittalLeg {
     pub ball: Vec<[f64; 2]>,
     /// Toe.
     pub toe: Vec<[f64; 2]>,
+    /// The pelvis centre (the model's hip H) when it is measured directly, e.g. the midpoint of
+    /// both hip joint centres; `None` estimates it from `hip` and its mirror half a stride
+    /// later (Winter's table has one side only).
+    pub pelvis: Option<Vec<[f64; 2]>>,
 }
 
 /// One stride's events of the leg, s: heel strike, toe off, next heel strike.
@@ -208,6 +212,7 @@ pub fn build_prototype(
         ("heel", &leg.heel),
         ("ball", &leg.ball),
         ("toe", &leg.toe),
+        ("pelvis", leg.pelvis.as_ref().unwrap_or(&leg.hip)),
     ] {
         if v.len() != n {
             return Err(err(
@@ -273,6 +278,9 @@ pub fn build_prototype(
     // one step away in space) — the pelvis centre in the sagittal plane. Each trochanter marker
     // alone sits ±3.5 cm off it at heel strike as the thigh swings.
     let pelvis = |t: f64| {
+        if let Some(p) = &leg.pelvis {
+            return at(p, t);
+        }
         let a = at(&leg.hip, t);
         let b = if t + tau <= hs1 {
             let q = at(&leg.hip, t + tau);
@@ -547,6 +555,7 @@ pub fn winter_leg(
         heel: get("RIGHT HEEL")?,
         ball: get("RIGHT MT5")?,
         toe: get("RIGHT TOE")?,
+        pelvis: None,
     };
     let t = |frame: usize| -> Result<f64, GenerateError> {
         m.time_s.get(frame - 1).copied().ok_or_else(|| {
@@ -850,6 +859,9 @@ pub fn winter_prototype(
 /// the mean of this hip and the mirrored other hip (this one half a stride away, one step
 /// `sl` away).
 pub(crate) fn pelvis_at(leg: &SagittalLeg, ev: &StrideEvents, sl: f64, t: f64) -> [f64; 2] {
+    if let Some(p) = &leg.pelvis {
+        return sample(&leg.time_s, p, t);
+    }
     let tau = 0.5 * (ev.next_heel_strike - ev.heel_strike);
     let a = sample(&leg.time_s, &leg.hip, t);
     let b = if t + tau <= ev.next_heel_strike {
