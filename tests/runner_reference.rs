@@ -165,3 +165,55 @@ fn every_step_satisfies_eqs_3_and_7() {
         }
     }
 }
+
+/// The paper's Fig. 4 example carried through the generated motion: v locked at 12 km/h and
+/// sf raised from 187 to 210 steps/min; once steady, the run measured by gaitfit's own event
+/// detection (foot-marker heights, default options, 120 fps) has sl 0.95 m and sf 210/min
+/// (1 %), and every steady step was planned with the paper's H (0.001 m; here 0.0013).
+#[test]
+fn locked_speed_example_in_the_generated_run() {
+    use gaitfit::events::{steps_from_trial, EventOptions, Gait, PrimarySource};
+    let (m, a) = model();
+    let mut p = m.natural(12.0 / 3.6, 0.0, &a).unwrap();
+    p.locks.speed = true;
+    let q = m.set(&p, Param::StepFreq, 210.0 / 60.0, &a).unwrap();
+    let opts = GenerateOptions {
+        seconds: 6.0,
+        fps: 120.0,
+        stop_at_end: false,
+    };
+    let (mo, rep) = generate_run(&m, q, a, None, &opts).unwrap();
+    let steady = rep
+        .steps
+        .iter()
+        .find(|s| (s.step_freq - q.step_freq).abs() < 1e-12)
+        .unwrap()
+        .start_s;
+    for s in rep.steps.iter().filter(|s| s.start_s >= steady) {
+        assert!((s.report.flight_height - 0.001).abs() < 0.0005);
+        assert!((s.step_length - 0.9524).abs() < 1e-4);
+    }
+    let eo = EventOptions {
+        primary: PrimarySource::FootHeight,
+        gait: Some(Gait::Run),
+        ..EventOptions::default()
+    };
+    let table = steps_from_trial(&mo.to_trial("fig4"), &eo).unwrap();
+    let rows: Vec<_> = table
+        .rows
+        .iter()
+        .filter(|r| r.time_s.unwrap() > steady + 0.05 && r.time_s.unwrap() < mo.duration_s() - 0.5)
+        .collect();
+    assert!(rows.len() >= 10, "{} steady steps", rows.len());
+    let mean = |f: &dyn Fn(&gaitfit::ingest::trials::StepRow) -> f64| {
+        rows.iter().map(|r| f(r)).sum::<f64>() / rows.len() as f64
+    };
+    let sl = mean(&|r| r.step_length_m.unwrap());
+    let sf = mean(&|r| r.step_freq_hz.unwrap()) * 60.0;
+    println!(
+        "Fig. 4 run, detected: sl {sl:.4} m, sf {sf:.2} steps/min over {} steps",
+        rows.len()
+    );
+    assert!((sl / 0.95 - 1.0).abs() < 0.01, "sl {sl}");
+    assert!((sf / 210.0 - 1.0).abs() < 0.01, "sf {sf}");
+}

@@ -285,8 +285,7 @@ pub struct StepPlan {
     pub swing: Track,
     /// Effective attributes of the step.
     pub eff: Effective,
-    /// Upper-body attributes at the start of the step (blended into `eff`'s over the first half
-    /// of support).
+    /// Upper-body attributes at the start of the step (blended into `eff`'s over the step).
     pub upper0: UpperAttrs,
     /// Sway phase keys (t, phase).
     pub sway: [(f64, f64); 4],

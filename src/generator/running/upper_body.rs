@@ -55,7 +55,7 @@ pub fn arm_beta(plan: &StepPlan, t: f64, stance: bool) -> f64 {
 }
 
 /// Upper-body attributes in force at step time `t` (blended from the previous step's over the
-/// first half of support; toward rest over a stop).
+/// step; toward rest over a stop).
 #[inline]
 pub fn upper_at(plan: &StepPlan, t: f64) -> UpperAttrs {
     let target = match plan.kind {
@@ -73,12 +73,9 @@ pub fn upper_at(plan: &StepPlan, t: f64) -> UpperAttrs {
         }
         _ => super::state::upper_attrs(&plan.eff),
     };
-    let span = if plan.kind == StepKind::Stop {
-        plan.t_step
-    } else {
-        plan.t_ms.max(1e-6)
-    };
-    let s = smooth01(t / span);
+    // Over the whole step: at high step frequencies the support lasts only a few frames, and
+    // a blend over it alone would snap the arms to a new parameter set.
+    let s = smooth01(t / plan.t_step.max(1e-6));
     let mut u = plan.upper0;
     for (a, b) in u.iter_mut().zip(target.iter()) {
         *a += s * (b - *a);
@@ -136,7 +133,7 @@ pub fn fill_upper(
     r[Joint::Head.index()] = w_neck.inverse();
     // Arms, relative to the thorax (the clavicles stay at rest).
     let (arm_back, arm_front) = {
-        let s = smooth01(t / plan.t_ms.max(1e-6));
+        let s = smooth01(t / plan.t_step.max(1e-6));
         (
             plan.arm_back.0 + s * (plan.arm_back.1 - plan.arm_back.0),
             plan.arm_front.0 + s * (plan.arm_front.1 - plan.arm_front.0),
