@@ -31,6 +31,8 @@
 //! Standard errors of linear coefficients are conditional on the breakpoint estimates (the
 //! usual profile approach); the bootstrap intervals, which refit the breakpoints in every
 //! replicate, include that uncertainty.
+//!
+//! [`minimize_1d`]: super::nonlinear::minimize_1d
 use super::ols::{huber_irls, ols, LinearFit, LinearProblem};
 use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
