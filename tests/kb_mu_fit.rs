@@ -106,6 +106,19 @@ fn bounded_fit_equals_clamped_separable_lines() {
         1.0 - rss / tss
     );
     assert!(rec.derived.iter().any(|d| d.name == "mu4: r² (centred)"));
+    // Per-μ leave-one-subject-out with bounded refits per fold; pooled it agrees with the
+    // pipeline's (which keeps α₁ on its bound in every fold) to a few per cent.
+    let d = |n: &str| rec.derived.iter().find(|d| d.name == n).map(|d| d.value);
+    for i in 1..=4 {
+        let v = d(&format!(
+            "mu{i}: leave-one-subject-out rmse (bounded refits)"
+        ))
+        .unwrap();
+        assert!(v > d(&format!("mu{i}: rmse")).unwrap());
+    }
+    let pooled = d("all outputs: leave-one-subject-out rmse (bounded refits)").unwrap();
+    let loso = rec.loso_rmse.unwrap();
+    assert!((pooled / loso - 1.0).abs() < 0.05, "{pooled} vs {loso}");
 }
 
 /// A trials table of `subjects × steps` walking steps with μ = the μ-functions at `alpha`, `mu`

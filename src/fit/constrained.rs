@@ -16,8 +16,11 @@
 //! Each row gives one observation per output (a μ-function of `kb-mu`). The pooled r² centres
 //! every output on its own mean, 1 − RSS/Σₖ Σ_{i∈k} (yᵢ − ȳₖ)², so that the different levels of
 //! the outputs (a knee angle near 0, a foot angle near 70°) do not count as explained variance;
-//! per output, n, r² (centred on its mean), rmse, leave-one-out rmse and the published
-//! coefficients' r² and rmse are reported as derived quantities.
+//! per output, n, r² (centred on its mean), rmse, leave-one-out rmse, leave-one-subject-out
+//! rmse and the published coefficients' r² and rmse are reported as derived quantities. The
+//! per-output leave-one-subject-out errors re-solve the bounded problem in every fold (argmin),
+//! so they also count folds where a bound that is active on all data would not be; the
+//! record's pooled `loso_rmse` (generic pipeline) keeps it on the bound.
 use super::nonlinear::{nls, Model, NlsOptions, Rows};
 use super::pipeline::Prepared;
 use super::FitError;
@@ -189,12 +192,68 @@ fn within_ss(rel: &dyn Relation, prep: &Prepared, w: &[f64], k: usize) -> (usize
     (rows.len(), tss)
 }
 
+/// Leave-one-subject-out squared prediction errors per observation, the bounded problem
+/// re-solved by argmin on the other subjects in every fold over the parameters
+/// [`Relation::plan`] leaves free (so a bound active on all data may be inactive in a fold);
+/// NaN where a fold failed or with fewer than 3 subjects.
+fn loso_bounded(rel: &dyn Relation, prep: &Prepared, values: &[f64], weighted: bool) -> Vec<f64> {
+    let n = prep.obs.len();
+    let mut sq = vec![f64::NAN; n];
+    if prep.subjects.len() < 3 {
+        return sq;
+    }
+    let idx: Vec<usize> = rel
+        .plan(&prep.obs)
+        .held
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| h.is_none())
+        .map(|(i, _)| i)
+        .collect();
+    let ranges: Vec<(f64, f64)> = idx.iter().map(|&i| rel.bounds(i)).collect();
+    let start: Vec<f64> = idx
+        .iter()
+        .zip(&ranges)
+        .map(|(&i, b)| values[i].clamp(b.0, b.1))
+        .collect();
+    let model = Adapter {
+        rel,
+        p: values,
+        idx: &idx,
+    };
+    for s in 0..prep.subjects.len() {
+        let train: Vec<usize> = (0..n).filter(|&i| prep.subject[i] != s).collect();
+        let rows: Vec<f64> = train.iter().flat_map(|&i| prep.obs[i].x).collect();
+        let y: Vec<f64> = train.iter().map(|&i| prep.obs[i].y).collect();
+        let opts = NlsOptions {
+            name: rel.id().to_string(),
+            bounds: Some(ranges.clone()),
+            weights: weighted.then(|| train.iter().map(|&i| prep.weights[i]).collect()),
+            ..NlsOptions::default()
+        };
+        let Ok(rows) = Rows::new(&rows, MAX_INPUTS) else {
+            continue;
+        };
+        if let Ok(r) = nls(&model, rows, &y, &start, &opts) {
+            let q = model.full(&r.theta);
+            for i in (0..n).filter(|&i| prep.subject[i] == s) {
+                let o = &prep.obs[i];
+                sq[i] = (o.y - rel.predict_with(&q, 0.0, &o.x)).powi(2);
+            }
+        }
+    }
+    sq
+}
+
 /// Pooled and per-output statistics from the residuals of the refit (`residuals`, with their
-/// `leverage`) and of the published coefficients (`published_residuals`). `df` is the
-/// residual degrees of freedom of the fit. `None` for single-output relations.
+/// `leverage`, at coefficients `values`) and of the published coefficients
+/// (`published_residuals`). `df` is the residual degrees of freedom of the fit. `None` for
+/// single-output relations.
+#[allow(clippy::too_many_arguments)]
 pub fn output_stats(
     rel: &dyn Relation,
     prep: &Prepared,
+    values: &[f64],
     residuals: &[f64],
     leverage: &[f64],
     published_residuals: &[f64],
@@ -206,6 +265,19 @@ pub fn output_stats(
         return None;
     }
     let n = prep.obs.len();
+    let loso = loso_bounded(rel, prep, values, weighted);
+    let loso_rmse = |rows: &[usize]| {
+        let v: Vec<f64> = rows
+            .iter()
+            .map(|&i| loso[i])
+            .filter(|v| v.is_finite())
+            .collect();
+        if v.len() == rows.len() && !v.is_empty() {
+            (v.iter().sum::<f64>() / v.len() as f64).sqrt()
+        } else {
+            f64::NAN
+        }
+    };
     let ones = vec![1.0; n];
     let w: &[f64] = if weighted { &prep.weights } else { &ones };
     let (mut tss, mut rss, mut prss) = (0.0, 0.0, 0.0);
@@ -254,6 +326,26 @@ pub fn output_stats(
         derived.push(rec("rmse", unit, rmse, prmse));
         // Fixed (published) coefficients are not refitted, so their held-out error is their rmse.
         derived.push(rec("leave-one-out rmse", unit, loo, prmse));
+        let ls = loso_rmse(&rows);
+        if ls.is_finite() {
+            derived.push(rec(
+                "leave-one-subject-out rmse (bounded refits)",
+                unit,
+                ls,
+                prmse,
+            ));
+        }
+    }
+    let all: Vec<usize> = (0..n).collect();
+    let ls = loso_rmse(&all);
+    if ls.is_finite() {
+        let prmse = (published_residuals.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
+        derived.push(DerivedRecord {
+            name: "all outputs: leave-one-subject-out rmse (bounded refits)".into(),
+            unit: unit.to_string(),
+            value: ls,
+            published: prmse,
+        });
     }
     let r2 = 1.0 - rss / tss;
     Some(OutputStats {

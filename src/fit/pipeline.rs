@@ -916,6 +916,7 @@ pub fn fit_relation(
     let multi = super::constrained::output_stats(
         rel,
         &prep,
+        &values,
         &residuals,
         lf.leverage.as_slice(),
         &pub_res,
