@@ -151,6 +151,9 @@ attributes! {
     ankle_heel_strike_deg: 90.0, [70.0, 115.0], "deg";
     /// Ankle angle θ5 of the swing foot at the end of swing1 (dorsiflexed for toe clearance).
     ankle_mid_swing_deg: 100.0, [70.0, 125.0], "deg";
+    /// Dorsiflexion limit of the swing ankle θ5: the toe-clearance rule of the kinematic swing
+    /// foot dorsiflexes the ankle up to here (a typical active range is 20–30° past neutral).
+    ankle_swing_dorsiflexion_max_deg: 115.0, [90.0, 140.0], "deg";
     /// Knee flexion at toe-off, reached through the meta-off period (θ5 at toe-off follows).
     knee_toe_off_deg: 35.0, [0.0, 80.0], "deg";
     /// Ankle dorsiflexion limit θ5 that ends the normal period and starts heel-off (§4.2).

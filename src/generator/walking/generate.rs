@@ -9,7 +9,7 @@ use super::attributes::WalkAttributes;
 use super::body::Body;
 use super::collision::{self, SwingAtImpact};
 use super::dynamics::{HipMotion, StanceModel};
-use super::foot::{smoothstep, FootShape};
+use super::foot::FootShape;
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::swing::{SwingRun, SwingSpec, SwingStart};
@@ -20,7 +20,7 @@ use crate::generator::motion::{Motion, MotionMetadata};
 use crate::generator::skeleton::{Euler, Joint, Skeleton};
 use crate::generator::GenerateError;
 use glam::{DQuat, DVec3};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 /// How a walk is to be generated (besides its steps).
 #[derive(Debug, Clone, PartialEq)]
@@ -195,8 +195,7 @@ struct StepData {
     det: Determinants,
     stance: StanceRun,
     swing: SwingRun,
-    swing_theta5: [f64; 3],
-    swing_theta6: f64,
+    swing_foot: super::swing::SwingFoot,
     swing_times: [f64; 4],
     /// Virtual-leg roll samples of the stance leg over the step (time from step start, ρ).
     stance_rho: Vec<(f64, f64)>,
@@ -204,6 +203,8 @@ struct StepData {
     /// Trailing leg over the double support.
     trail_rho: Vec<(f64, f64)>,
     trail_leg: VirtualLeg,
+    /// Global time of the trailing leg's clock origin, s.
+    trail_origin: f64,
 }
 
 fn interp_rho(samples: &[(f64, f64)], t: f64) -> f64 {
@@ -234,6 +235,13 @@ fn side_z(side: Side, a: &WalkAttributes) -> f64 {
         Side::Right => 0.5 * a.stride_width_m,
     }
 }
+
+/// Shortest meta-off knee flexion, as a fraction of the double support (see
+/// [`VirtualLeg::min_knee_blend`]).
+const MIN_KNEE_BLEND: f64 = 0.3;
+
+/// Unrecorded steps simulated before a steady (not from rest) start.
+pub const PRE_ROLL: usize = 1;
 
 /// Generates a walk of the given steps (complete locomotion parameters, one per step).
 pub fn generate_steps(
@@ -271,7 +279,17 @@ pub fn generate_steps(
         Side::Left => 0,
         Side::Right => 1,
     };
-    let mut stance_side = Side::Left;
+    // A steady start is preceded by PRE_ROLL unrecorded copies of the first step: the steady
+    // state is only approximated for the first of them (eq. 3 and the speed), and its trailing
+    // foot has no history, so it may toe off late and abruptly. One simulated step brings the
+    // hip's velocities, the forces and the trailing foot's roll onto the periodic walk (the
+    // shooting then carries them on), so the recorded walk starts steady.
+    let pre = if opt.start_from_rest { 0 } else { PRE_ROLL };
+    let mut stance_side = if pre % 2 == 0 {
+        Side::Left
+    } else {
+        Side::Right
+    };
     let mut stance_start = StanceStart {
         q: [body.l1, 0.0, a.trunk_lean_deg.to_radians()],
         qd: [0.0; 3],
@@ -288,7 +306,12 @@ pub fn generate_steps(
             q: [hs.w, th, a.trunk_lean_deg.to_radians()],
             qd: [v * th.sin(), v * th.cos() / hs.w, 0.0],
         };
-        ankle_x = [0.0, -l.step_length_m];
+        // The recorded walk's first stance foot lands at x = 0.
+        let back = pre as f64 * l.step_length_m;
+        ankle_x = match stance_side {
+            Side::Left => [-back, -back - l.step_length_m],
+            Side::Right => [-back - l.step_length_m, -back],
+        };
     }
     // The trailing leg's virtual-leg state.
     let mk_leg = |flat_x: f64, period: FootPeriod, rho: f64| VirtualLeg {
@@ -300,6 +323,7 @@ pub fn generate_steps(
         theta6_max: a.metatarsal_max_deg.to_radians(),
         knee_toe_off: a.knee_toe_off_deg.to_radians(),
         toe_off_time: 0.0,
+        min_knee_blend: 0.0,
         period,
         rho,
         meta_start: None,
@@ -314,17 +338,32 @@ pub fn generate_steps(
     }
     let mut stance_guess = [0.0, 0.0];
     let mut swing_guess = [0.0, 0.0, 0.0, 0.0];
-    let mut t_global = 0.0;
+    let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
+        .chain(steps.iter().copied())
+        .collect();
+    let mut t_global =
+        -(pre as f64) * phase_times(steps[0].step_freq_steps_per_min, &opt.relations).step;
     let mut prev_hs_pitch = if from_rest {
         0.0
     } else {
         heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch
     };
-    let n = steps.len();
-    for (k, l) in steps.iter().enumerate() {
-        let stage = |what: &str| format!("step {k} ({} stance), {what}", stance_side);
+    let n = all.len();
+    for (kk, l) in all.iter().enumerate() {
+        let recorded = kk >= pre;
+        let k = kk.saturating_sub(pre);
+        let stage = |what: &str| {
+            if recorded {
+                format!("step {k} ({} stance), {what}", stance_side)
+            } else {
+                format!(
+                    "steady-state pre-roll step ({} stance), {what}",
+                    stance_side
+                )
+            }
+        };
         let swing_side = stance_side.opposite();
-        let to_rest = opt.stop && k + 1 == n;
+        let to_rest = opt.stop && kk + 1 == n;
         let times = phase_times(l.step_freq_steps_per_min, &opt.relations);
         let t_step = times.step;
         let det = Determinants {
@@ -399,6 +438,7 @@ pub fn generate_steps(
         let dt_v = 2e-3;
         let t_ds = times.double_support;
         trailing.toe_off_time = trailing_clock + t_ds;
+        trailing.min_knee_blend = MIN_KNEE_BLEND * t_ds;
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
         let zf_w = side_z(swing_side, a);
@@ -426,13 +466,13 @@ pub fn generate_steps(
             qd: [d(q0[0], q1[0], q2[0]), d(q0[1], q1[1], q2[1])],
         };
         // 3. The stance leg's virtual leg over the step.
-        let mut stance_leg = if from_rest && k == 0 {
+        let mut stance_leg = if from_rest && kk == 0 {
             mk_leg(ax, FootPeriod::Flat, 0.0)
         } else {
             mk_leg(ax, FootPeriod::HeelRocker, -prev_hs_pitch)
         };
-        let next_times = steps
-            .get(k + 1)
+        let next_times = all
+            .get(kk + 1)
             .map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
         stance_leg.toe_off_time = t_step
             + next_times
@@ -470,6 +510,7 @@ pub fn generate_steps(
             ],
             hip_spring: [m33 * om3 * om3, 2.0 * a.swing_hip_damping * m33 * om3],
             clearance: a.toe_clearance_m,
+            theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
             max_step: a.max_step_s,
         };
         let sw = sspec
@@ -506,54 +547,56 @@ pub fn generate_steps(
             },
             [new_ankle_x, body.l9],
         );
-        report.steps.push(StepReport {
-            index: k,
-            stance_side,
-            start_s: t_global,
-            step_length_m: l.step_length_m,
-            step_freq_steps_per_min: l.step_freq_steps_per_min,
-            times,
-            iterations: [
-                st_solved.iterations,
-                sw.iterations[0],
-                sw.iterations[1],
-                sw.iterations[2],
-            ],
-            forces: [
-                st_solved.x[0],
-                st_solved.x[1],
-                sw.params[0],
-                sw.params[1],
-                sw.params[2],
-            ],
-            errors: [
-                st_solved.residual[1],
-                st_solved.residual[0],
-                sw.end_errors[0],
-                sw.end_errors[1],
-                sw.end_errors[2],
-            ],
-            recovery_rounds: sw.recovery_rounds,
-            min_clearance_m: sw.min_clearance,
-            lock_s: st_run.lock_time,
-        });
-        data.push(StepData {
-            side: stance_side,
-            start: t_global,
-            loc: *l,
-            times,
-            ankle_x: ax,
-            det,
-            stance: st_run,
-            swing: sw,
-            swing_theta5: [p0.theta5, a.ankle_mid_swing_deg.to_radians(), theta5_hs],
-            swing_theta6: p0.toe_bend,
-            swing_times,
-            stance_rho,
-            stance_leg: stance_leg.clone(),
-            trail_rho,
-            trail_leg,
-        });
+        if recorded {
+            report.steps.push(StepReport {
+                index: k,
+                stance_side,
+                start_s: t_global,
+                step_length_m: l.step_length_m,
+                step_freq_steps_per_min: l.step_freq_steps_per_min,
+                times,
+                iterations: [
+                    st_solved.iterations,
+                    sw.iterations[0],
+                    sw.iterations[1],
+                    sw.iterations[2],
+                ],
+                forces: [
+                    st_solved.x[0],
+                    st_solved.x[1],
+                    sw.params[0],
+                    sw.params[1],
+                    sw.params[2],
+                ],
+                errors: [
+                    st_solved.residual[1],
+                    st_solved.residual[0],
+                    sw.end_errors[0],
+                    sw.end_errors[1],
+                    sw.end_errors[2],
+                ],
+                recovery_rounds: sw.recovery_rounds,
+                min_clearance_m: sw.min_clearance,
+                lock_s: st_run.lock_time,
+            });
+            data.push(StepData {
+                side: stance_side,
+                start: t_global,
+                loc: *l,
+                times,
+                ankle_x: ax,
+                det,
+                stance: st_run,
+                swing: sw,
+                swing_foot: sspec.swing_foot(),
+                swing_times,
+                stance_rho,
+                stance_leg: stance_leg.clone(),
+                trail_rho,
+                trail_leg,
+                trail_origin: t_global - trailing_clock,
+            });
+        }
         // Next step.
         ankle_x[idx(swing_side)] = new_ankle_x;
         trailing = stance_leg;
@@ -639,22 +682,14 @@ fn assemble(
             let (sq, _, _) = d.swing.track.at(tau);
             let hip = [x_dyn + off.x, y_dyn + 2.0 * off.y];
             let (_, an) = swing_model.knee_ankle(&sq);
-            let [t0, t1, _, t3] = d.swing_times;
-            let [to, mid, hs5] = d.swing_theta5;
-            let s1 = smoothstep((tau - t0) / (t1 - t0));
-            let th5 = if tau <= t1 {
-                to + (mid - to) * s1
-            } else {
-                mid + (hs5 - mid) * smoothstep((tau - t1) / (t3 - t1))
-            };
-            let th6 = d.swing_theta6 * (1.0 - s1);
-            let pitch = th5 - FRAC_PI_2 - (sq[0] + sq[1]);
+            let ankle = [hip[0] + an[0], hip[1] + an[1]];
+            let (pitch, th6) = d.swing_foot.pose(tau, ankle, sq[0] + sq[1]);
             (
                 place_leg(
                     skeleton,
                     &mut pose,
                     swing,
-                    [hip[0] + an[0], hip[1] + an[1], side_z(swing, a)],
+                    [ankle[0], ankle[1], side_z(swing, a)],
                     pitch,
                     th6,
                 ),
@@ -722,7 +757,7 @@ fn assemble(
             }
         }
         let tr = d.trail_leg.transitions;
-        let prev_start = if k > 0 { data[k - 1].start } else { d.start };
+        let prev_start = d.trail_origin;
         for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff]
             .iter()
             .enumerate()

@@ -104,7 +104,7 @@ pub fn solve_1d<F: FnMut(f64) -> f64>(
         if fc.abs() <= tol {
             return done(c, fc, evals);
         }
-        if (b - a).abs() < 1e-13 * (1.0 + c.abs()) {
+        if (b - a).abs() < 1e-10 * (1.0 + c.abs()) {
             // The bracket has collapsed onto a jump of the residual (no exact root in floating
             // point): return the better end; the caller reports the remaining error.
             let (x, r) = if fa.abs() < fb.abs() {

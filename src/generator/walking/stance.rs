@@ -188,7 +188,55 @@ impl StanceSpec {
                 qdd: [d[3], d[4], d[5]],
             }
         };
-        while t < self.duration {
+        let l1 = self.l1;
+        // The middle level's event functions: a subphase ends when its function reaches 0.
+        let event_value = |sub: Sub, yy: &[f64; 7]| match sub {
+            Sub::CompressAbove => (l1 - yy[0]).max(yy[1]),
+            Sub::CompressBelow => (yy[0] - l1).max(yy[1]),
+            Sub::Rigid => yy[1],
+            Sub::Extend => -1.0,
+        };
+        let mut fired = false;
+        loop {
+            // Switch subphase on an event, or when a segment starts past its event (a boundary
+            // at the torque switch-off can fall between the crossing and its detection).
+            // Which condition fired is decided by the state with a tolerance: the located
+            // event is exact to 1e-12 s, so θ1 may sit a rounding error below 0 when the leg
+            // passes the vertical.
+            if fired || (sub != Sub::Extend && event_value(sub, &y) > 1e-12) {
+                fired = false;
+                if y[1] >= -1e-9 {
+                    let pa_u = if sub == Sub::Rigid {
+                        let q = [y[0], y[1], y[2]];
+                        let qd = [y[3], y[4], y[5]];
+                        let f = self.forces(t, &y, a, sub, ext);
+                        self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
+                    } else {
+                        y[6]
+                    };
+                    ext = (t, pa_u, p);
+                    extend_time = Some(t);
+                    sub = Sub::Extend;
+                } else if sub == Sub::CompressAbove {
+                    sub = Sub::CompressBelow;
+                } else if sub == Sub::CompressBelow {
+                    // Lock: the impulse acts along the leg only.
+                    let q = [y[0], y[1], y[2]];
+                    let m = self.model.mass_matrix(&q);
+                    let p1 = m[1][0] * y[3] + m[1][1] * y[4] + m[1][2] * y[5];
+                    let p2 = m[2][0] * y[3] + m[2][1] * y[4] + m[2][2] * y[5];
+                    let v = solve2(&[[m[1][1], m[1][2]], [m[2][1], m[2][2]]], &[p1, p2]);
+                    y[3] = 0.0;
+                    y[4] = v[0];
+                    y[5] = v[1];
+                    lock_time = Some(t);
+                    sub = Sub::Rigid;
+                }
+                continue;
+            }
+            if t >= self.duration {
+                break;
+            }
             let t_end = if t < self.torque_off {
                 self.torque_off.min(self.duration)
             } else {
@@ -199,13 +247,7 @@ impl StanceSpec {
             }
             let spec = *self;
             let mut f = |tt: f64, yy: &[f64; 7]| spec.deriv(tt, yy, a, sub, ext, floor);
-            let l1 = self.l1;
-            let mut ev = |_tt: f64, yy: &[f64; 7]| match sub {
-                Sub::CompressAbove => (l1 - yy[0]).max(yy[1]),
-                Sub::CompressBelow => (yy[0] - l1).max(yy[1]),
-                Sub::Rigid => yy[1],
-                Sub::Extend => -1.0,
-            };
+            let mut ev = |_tt: f64, yy: &[f64; 7]| event_value(sub, yy);
             let mut tr: Vec<Node<3>> = Vec::new();
             let mut obs = |_t0: f64, _y0: &[f64; 7], t1: f64, y1: &[f64; 7]| {
                 if record {
@@ -216,37 +258,7 @@ impl StanceSpec {
             track.nodes.extend(tr);
             t = seg.t;
             y = seg.y;
-            if !seg.event {
-                continue;
-            }
-            // Switch subphase.
-            if y[1] >= 0.0 {
-                let pa_u = if sub == Sub::Rigid {
-                    let q = [y[0], y[1], y[2]];
-                    let qd = [y[3], y[4], y[5]];
-                    let f = self.forces(t, &y, a, sub, ext);
-                    self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
-                } else {
-                    y[6]
-                };
-                ext = (t, pa_u, p);
-                extend_time = Some(t);
-                sub = Sub::Extend;
-            } else if sub == Sub::CompressAbove {
-                sub = Sub::CompressBelow;
-            } else if sub == Sub::CompressBelow {
-                // Lock: the impulse acts along the leg only.
-                let q = [y[0], y[1], y[2]];
-                let m = self.model.mass_matrix(&q);
-                let p1 = m[1][0] * y[3] + m[1][1] * y[4] + m[1][2] * y[5];
-                let p2 = m[2][0] * y[3] + m[2][1] * y[4] + m[2][2] * y[5];
-                let v = solve2(&[[m[1][1], m[1][2]], [m[2][1], m[2][2]]], &[p1, p2]);
-                y[3] = 0.0;
-                y[4] = v[0];
-                y[5] = v[1];
-                lock_time = Some(t);
-                sub = Sub::Rigid;
-            }
+            fired = seg.event;
         }
         if record {
             track.push(node(self, t, &y, sub, ext));
@@ -270,6 +282,24 @@ impl StanceSpec {
         let f = |x: [f64; 2]| {
             let r = self.run(start, x[0], x[1], h, false);
             [r.end[1] - self.target[1], r.end[0] - self.target[0]]
+        };
+        // Without a previous step's profile (the walk's first step), a coarse scan of the step
+        // torque picks the start: the Broyden iteration needs a start near the solution, and far
+        // from it the pendulum falls (the residual saturates and the Jacobian is meaningless).
+        let guess = if guess == [0.0, 0.0] {
+            let scale = (self.model.m1 + self.model.m2) * self.model.g * self.l1;
+            let mut best = (f64::INFINITY, guess);
+            for i in 0..=16 {
+                let x = [scale * (0.5 * i as f64 / 16.0 - 0.05), 0.0];
+                let r = f(x);
+                let n = (r[0] / 0.01).hypot(r[1] / 0.01);
+                if n < best.0 {
+                    best = (n, x);
+                }
+            }
+            best.1
+        } else {
+            guess
         };
         let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 160)?;
         let run = self.run(start, solved.x[0], solved.x[1], h, true);

@@ -52,8 +52,91 @@ pub struct SwingSpec<'a> {
     pub hip_spring: [f64; 2],
     /// Minimum clearance of the foot over the ground in swing2, m.
     pub clearance: f64,
+    /// Largest ankle angle θ5 of the swing foot (dorsiflexion limit), rad.
+    pub theta5_max: f64,
     /// Largest integration step, s.
     pub max_step: f64,
+}
+
+/// The kinematic swing foot (§4.3): the ankle angle θ5 and the toe bend θ6 are interpolated
+/// (C¹ blends) between their toe-off values, a dorsiflexed value at the end of swing1 and the
+/// heel-strike values; θ6 returns to 0 by the end of swing1.
+///
+/// The paper interpolates θ5 and θ6 between toe-off and heel strike only. In slow walks (long
+/// swings, short steps) that foot pitches toe-down while the knee extends in swing2 and the toe
+/// goes through the ground, and no temporary hip torque can lift it in time (the dip comes a few
+/// centiseconds into swing2, faster than the thigh responds). The locomotion attribute "toe
+/// clearance during swing" is therefore also honoured kinematically, as a person does: the ankle
+/// dorsiflexes beyond the interpolated value just enough for the toe and ball to stay
+/// `clearance` above the ground (the clearance ramps in from 0 at toe-off over the first 30 % of
+/// swing1, while the toe is leaving the ground), up to the dorsiflexion limit `theta5_max`. The
+/// dynamic recovery of swing2 still handles what this cannot (the heel).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SwingFoot {
+    /// The foot.
+    pub foot: FootShape,
+    /// Toe-off, end of swing1, end of swing2, heel strike, s.
+    pub times: [f64; 4],
+    /// θ5 at toe-off, at the end of swing1 and at heel strike, rad.
+    pub theta5: [f64; 3],
+    /// θ6 at toe-off, rad.
+    pub theta6_toe_off: f64,
+    /// Toe clearance, m.
+    pub clearance: f64,
+    /// Dorsiflexion limit of θ5, rad.
+    pub theta5_max: f64,
+}
+
+impl SwingFoot {
+    /// Interpolated θ5 and θ6 at `t` (before the clearance rule).
+    pub fn theta56(&self, t: f64) -> (f64, f64) {
+        let [t0, t1, _, t3] = self.times;
+        let [to, mid, hs] = self.theta5;
+        let s1 = smoothstep((t - t0) / (t1 - t0));
+        let th5 = if t <= t1 {
+            to + (mid - to) * s1
+        } else {
+            mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1))
+        };
+        (th5, self.theta6_toe_off * (1.0 - s1))
+    }
+
+    /// Foot pitch φ (toes up positive) and toe bend θ6 at `t`, for the ankle at `ankle` (ground
+    /// frame) and the shank at `shank = θ3 + θ4` from the vertical.
+    pub fn pose(&self, t: f64, ankle: [f64; 2], shank: f64) -> (f64, f64) {
+        let [t0, t1, _, _] = self.times;
+        let (th5, th6) = self.theta56(t);
+        let mut phi = th5 - FRAC_PI_2 - shank;
+        let need = self.clearance * smoothstep((t - t0) / (0.3 * (t1 - t0)));
+        let phi_max = self.theta5_max - FRAC_PI_2 - shank;
+        if phi >= phi_max {
+            return (phi, th6);
+        }
+        // Newton on the lower of toe and ball: d(point_y)/dφ = (point − ankle)_x.
+        for _ in 0..4 {
+            let p = self.foot.points(ankle, phi, th6);
+            let (low, lx) = if p.toe[1] < p.ball[1] {
+                (p.toe[1], p.toe[0])
+            } else {
+                (p.ball[1], p.ball[0])
+            };
+            let slope = lx - ankle[0];
+            if low >= need - 1e-9 || slope <= 1e-6 {
+                break;
+            }
+            phi = (phi + (need - low) / slope).min(phi_max);
+            if phi >= phi_max {
+                break;
+            }
+        }
+        (phi, th6)
+    }
+
+    /// Foot sole points at `t` (see [`SwingFoot::pose`]).
+    pub fn points(&self, t: f64, ankle: [f64; 2], shank: f64) -> FootPoints {
+        let (phi, th6) = self.pose(t, ankle, shank);
+        self.foot.points(ankle, phi, th6)
+    }
 }
 
 /// State at toe-off: `[θ3, θ4]` and rates.
@@ -146,19 +229,16 @@ pub struct SwingRun {
 const TOL: f64 = 1e-8;
 
 impl SwingSpec<'_> {
-    /// θ5 and θ6 of the kinematic swing foot at `t`: θ5 from its toe-off value to its mid-swing
-    /// value at t1 (dorsiflexion for toe clearance), then to its heel-strike value; θ6 from its
-    /// toe-off value to 0 at t1. Each piece is a C¹ blend.
-    pub fn theta56(&self, t: f64) -> (f64, f64) {
-        let [t0, t1, _, t3] = self.times;
-        let [to, mid, hs] = self.theta5;
-        let s1 = smoothstep((t - t0) / (t1 - t0));
-        let th5 = if t <= t1 {
-            to + (mid - to) * s1
-        } else {
-            mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1))
-        };
-        (th5, self.theta6_toe_off * (1.0 - s1))
+    /// The kinematic swing foot of this swing.
+    pub fn swing_foot(&self) -> SwingFoot {
+        SwingFoot {
+            foot: self.foot,
+            times: self.times,
+            theta5: self.theta5,
+            theta6_toe_off: self.theta6_toe_off,
+            clearance: self.clearance,
+            theta5_max: self.theta5_max,
+        }
     }
 
     /// Knee and ankle positions (ground frame) for angles `q` at time `t`.
@@ -171,9 +251,7 @@ impl SwingSpec<'_> {
     /// Foot sole points for angles `q` at time `t`.
     pub fn foot_points(&self, t: f64, q: &[f64; 2]) -> FootPoints {
         let (_, ankle) = self.joints(t, q);
-        let (t5, t6) = self.theta56(t);
-        let phi = t5 - FRAC_PI_2 - (q[0] + q[1]);
-        self.foot.points(ankle, phi, t6)
+        self.swing_foot().points(t, ankle, q[0] + q[1])
     }
 
     fn segments(&self, a: f64, b: f64) -> Vec<(f64, f64)> {

@@ -83,6 +83,10 @@ pub struct VirtualLeg {
     pub knee_toe_off: f64,
     /// Time of toe-off in the leg's own clock, s (set when known).
     pub toe_off_time: f64,
+    /// Shortest duration of the meta-off knee flexion, s: when meta-off begins late (a leg
+    /// that rolled slowly), the knee flexes at this pace and has not quite reached its toe-off
+    /// value at toe-off, rather than snapping there — the swing starts from the knee's rate.
+    pub min_knee_blend: f64,
     /// Current period.
     pub period: FootPeriod,
     /// Current roll.
@@ -247,7 +251,12 @@ impl VirtualLeg {
         // Meta-off: the knee flexes (C¹ blend) toward its toe-off value; the foot rolls about the
         // toe tip just enough to close the chain.
         let (t_ms, knee_ms) = self.meta_start.unwrap_or((t, 0.0));
-        let s = smoothstep((t - t_ms) / (self.toe_off_time - t_ms).max(1e-6));
+        let s = smoothstep(
+            (t - t_ms)
+                / (self.toe_off_time - t_ms)
+                    .max(self.min_knee_blend)
+                    .max(1e-6),
+        );
         let knee = knee_ms + (self.knee_toe_off - knee_ms) * s;
         let (l3, l4) = (self.l3, self.l4);
         let d_target = (l3 * l3 + l4 * l4 + 2.0 * l3 * l4 * knee.cos()).sqrt();
