@@ -54,15 +54,22 @@ fn round_table(path: &Path) {
 fn generated_steps_refit_to_the_generating_coefficients() {
     let fits = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fits");
     let dir = tempfile::tempdir().unwrap();
-    // Speeds 6 … 21 km/h, two steps each, then a stop: both sides of v_norm (eq. 2's plateau)
-    // and of eq. 5's breakpoint k1. (Not faster: with the refitted coefficients a 1.6 m figure
-    // above ~22 km/h would need a flight longer than its step, which the generator refuses.)
-    let mut sched = String::from("step,speed_km_per_h,action\n");
-    for (i, kmh) in (0..11).map(|i| (i, 6.0 + 1.5 * i as f64)) {
-        sched += &format!("{},{kmh},run\n", 2 * i);
-    }
-    sched += "22,,stop\n";
-    std::fs::write(dir.path().join("sched.csv"), sched).unwrap();
+    // Speeds from 6 km/h up in 1.5 km/h, two steps each, then a stop: both sides of v_norm
+    // (eq. 2's plateau, 16–17.7 km/h for these heights) and of eq. 5's breakpoint k1. Not
+    // faster than 18 km/h at 1.6 m and 21 km/h above: beyond, the refitted eq. 5 leaves under
+    // a quarter of the step for support, which the generator refuses.
+    let schedule = |top: f64| {
+        let mut s = String::from("step,speed_km_per_h,action\n");
+        let mut i = 0;
+        while 6.0 + 1.5 * i as f64 <= top + 1e-9 {
+            s += &format!("{},{},run\n", 2 * i, 6.0 + 1.5 * i as f64);
+            i += 1;
+        }
+        s + &format!("{},,stop\n", 2 * i)
+    };
+    std::fs::write(dir.path().join("sched_1.6.csv"), schedule(18.0)).unwrap();
+    std::fs::write(dir.path().join("sched_1.8.csv"), schedule(21.0)).unwrap();
+    std::fs::write(dir.path().join("sched_1.95.csv"), schedule(21.0)).unwrap();
     let mut tables = Vec::new();
     for h in ["1.6", "1.8", "1.95"] {
         let steps = dir.path().join(format!("steps_{h}.csv"));
@@ -73,7 +80,7 @@ fn generated_steps_refit_to_the_generating_coefficients() {
                 "generate",
                 "run",
                 "--schedule",
-                "sched.csv",
+                &format!("sched_{h}.csv"),
                 "--height",
                 h,
                 "--fits",

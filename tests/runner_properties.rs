@@ -42,25 +42,24 @@ fn run(kmh: f64, h: f64, seconds: f64, stop: bool) -> (Motion, RunReport, RunPar
     let m = RunModel::published(h).unwrap();
     let a = RunAttributes::defaults(h);
     let p = m.natural(kmh / 3.6, 0.0, &a).unwrap();
-    let (mo, rep) = run_params(h, p, None, seconds, stop);
+    let (mo, rep) = run_params(&m, p, None, seconds, stop);
     (mo, rep, p)
 }
 
 fn run_params(
-    h: f64,
+    m: &RunModel,
     p: RunParams,
     schedule: Option<Schedule>,
     seconds: f64,
     stop: bool,
 ) -> (Motion, RunReport) {
-    let m = RunModel::published(h).unwrap();
-    let a = RunAttributes::defaults(h);
+    let a = RunAttributes::defaults(p.body_height);
     let opts = GenerateOptions {
         seconds,
         fps: FPS,
         stop_at_end: stop,
     };
-    generate_run(&m, p, a, schedule, &opts).unwrap()
+    generate_run(m, p, a, schedule, &opts).unwrap()
 }
 
 /// The ground checks every generated motion must pass (the whole motion: start from a stand,
@@ -175,7 +174,7 @@ fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
     let p = m
         .natural(kmh / 3.6, 0.0, &RunAttributes::defaults(h))
         .unwrap();
-    let reachable = check_steady_params(h, p)?;
+    let reachable = check_steady_params(&m, p)?;
     prop_assert!(
         reachable,
         "{kmh:.2} km/h, h {h:.2} m: natural parameters out of reach"
@@ -187,10 +186,11 @@ fn check_steady(kmh: f64, h: f64) -> Result<(), TestCaseError> {
 /// Returns false, having checked nothing else, when the generator reported the stance hip out
 /// of the leg's reach (a step too long for the figure at that frequency): the user is told
 /// (a report note), and the stance foot may then lift.
-fn check_steady_params(h: f64, p: RunParams) -> Result<bool, TestCaseError> {
+fn check_steady_params(m: &RunModel, p: RunParams) -> Result<bool, TestCaseError> {
     let kmh = p.speed * 3.6;
+    let h = p.body_height;
     // Long enough for the start, the speed build-up and ten steady steps.
-    let (mo, rep) = run_params(h, p, None, 1.0 + 20.0 / p.step_freq, false);
+    let (mo, rep) = run_params(m, p, None, 1.0 + 20.0 / p.step_freq, false);
     if rep.steps.iter().any(|s| s.report.out_of_reach) {
         prop_assert!(
             rep.notes.iter().any(|n| n.contains("out of reach")),
@@ -379,7 +379,7 @@ fn check_steady_params(h: f64, p: RunParams) -> Result<bool, TestCaseError> {
         sym.joints
     );
     // …and exactly, by sampling the generator itself at t and t + one step.
-    let m = RunModel::published(h).unwrap();
+    let m = m.clone();
     let a = RunAttributes::defaults(h);
     let sk = m.skeleton.clone();
     let mut r0 = Runner::new(m.clone(), p, a.clone(), None).unwrap();
@@ -437,8 +437,24 @@ proptest! {
         let p = m.set(&p, Param::StepFreq, p.step_freq * f, &a).unwrap();
         prop_assert!((p.speed * 3.6 - kmh).abs() < 1e-9);
         // Long steps at a low frequency can be beyond the figure's legs (reported, not run).
-        let reachable = check_steady_params(h, p)?;
+        let reachable = check_steady_params(&m, p)?;
         prop_assume!(reachable);
+    }
+
+    /// The same invariants with the repository's refitted relations (`fits/`, as `--fits fits/`
+    /// uses them), 6–14 km/h. Slower, the arms wobble at the refitted relations' very short
+    /// flights (elbow continuity ratio 5.4 > 5 at 5.1 km/h, 1.73 m). Faster, the refitted
+    /// relations ask for more than this figure's legs give: eq. 5's real-data flights (~0.09 s
+    /// at 180 steps/min against the published 0.19 s) leave a support so long that the stance
+    /// hip goes out of reach (reported as a note; from ~15 km/h at 1.9 m, 16–17 km/h at 1.5 m),
+    /// and beyond its data (> 209 steps/min) eq. 5's cubic rises to 0.231 s of flight, which
+    /// the generator refuses (see `refitted_relations_refuse_too_short_supports`).
+    #[test]
+    fn refitted_relations_run_cleanly(kmh in 6.0f64..14.0, h in 1.5f64..2.0) {
+        let m = refitted_model(h);
+        let p = m.natural(kmh / 3.6, 0.0, &RunAttributes::defaults(h)).unwrap();
+        let reachable = check_steady_params(&m, p)?;
+        prop_assert!(reachable, "{kmh:.2} km/h, h {h:.2} m: out of reach");
     }
 
     /// Parameter changes at the next step (a schedule changing speed twice, then a stop): the
@@ -457,7 +473,7 @@ proptest! {
         let sched = Schedule::parse(&text, "proptest").unwrap();
         let m = RunModel::published(h).unwrap();
         let p = m.natural(v1 / 3.6, 0.0, &RunAttributes::defaults(h)).unwrap();
-        let (mo, rep) = run_params(h, p, Some(sched), 30.0, false);
+        let (mo, rep) = run_params(&m, p, Some(sched), 30.0, false);
         let what = format!("{v1:.2} → {v2:.2} → {v3:.2} km/h, h {h:.2} m");
         ground_checks(&mo, &what)?;
         // The changes take effect at the scheduled steps.
@@ -484,6 +500,44 @@ fn worst_cases_over_a_grid() {
             println!("{name}: {v:.6}  [{at}]");
         }
     });
+}
+
+fn refitted_model(h: f64) -> RunModel {
+    let fits = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fits");
+    let rel = gaitfit::generator::running::equations::RunRelations::from_fits(&fits).unwrap();
+    let sk = gaitfit::generator::skeleton::Skeleton::from_height(
+        h,
+        gaitfit::generator::running::params::default_mass(h),
+    )
+    .unwrap();
+    RunModel::new(sk, rel).unwrap()
+}
+
+/// With the refitted relations at 4–25 km/h: a natural step whose eq. 5 flight leaves less
+/// than a quarter of the step for support is refused (with a message), never generated.
+#[test]
+fn refitted_relations_refuse_too_short_supports() {
+    let mut refused = 0;
+    for kmh in (4..=25).map(f64::from) {
+        for h in [1.5, 1.75, 2.0] {
+            let m = refitted_model(h);
+            let v = kmh / 3.6;
+            let sf = v / m.relations.step_length(v, 0.0, h);
+            let flight = m.relations.flight_time(sf, 0.0);
+            let p = m.natural(v, 0.0, &RunAttributes::defaults(h));
+            if flight > 0.75 / sf {
+                let e = p.expect_err("too short a support accepted").to_string();
+                assert!(e.contains("t_flight"), "{e}");
+                refused += 1;
+            } else {
+                assert!(p.is_ok(), "{kmh} km/h, h {h}: {:?}", p.err());
+            }
+        }
+    }
+    assert!(
+        refused > 0,
+        "the refitted eq. 5 was expected to overreach somewhere"
+    );
 }
 
 /// The extremes of the ranges, always checked.

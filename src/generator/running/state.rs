@@ -451,6 +451,12 @@ pub const STOP_KNEE: f64 = 15.0 * std::f64::consts::PI / 180.0;
 /// Longest stop phase, s at 1.8 m.
 pub const STOP_TIME: f64 = 0.6;
 
+/// Least support time as a fraction of the step. Eqs. 4–5 never ask for less (published: ≥ 26 %
+/// up to 25 km/h and +10 % step frequency), but a refitted eq. 5 extrapolated beyond its data
+/// can (0.231 s of flight in a 0.243 s step), and the legs then whirl through the support;
+/// sprinters' support is about 40 % of the step.
+pub const MIN_STANCE_FRACTION: f64 = 0.25;
+
 /// Least downward speed of the landing foot's lowest point at heel strike, m/s at 1.8 m.
 pub const LANDING_SPEED: f64 = 0.15;
 
@@ -675,6 +681,15 @@ pub fn state_keyframes(
         ));
     }
     let t_stance = t_step - t_flight;
+    if t_stance < MIN_STANCE_FRACTION * t_step {
+        return Err(numerical(
+            "flight time",
+            format!(
+                "t_flight = {t_flight:.4} s leaves a support of {t_stance:.4} s, under {:.0} % of the step (1/sf = {t_step:.4} s), which no leg can push off in; lower the flight height or the step frequency (or, with --fits, keep to the step frequencies the refitted eq. 5 was fitted on)",
+                MIN_STANCE_FRACTION * 100.0
+            ),
+        ));
+    }
     let w = (y2 - y1) / t_flight + 0.5 * G * t_flight; // vertical take-off velocity
     let flight_height = w * w / (2.0 * G); // eq. 3
     Ok(StateKeys {
