@@ -80,6 +80,19 @@ fn rels() -> Vec<Box<dyn Relation>> {
 }
 
 fn bench(c: &mut Criterion) {
+    // One core: the target is single-threaded (the pipeline's folds use rayon's global
+    // pool, which this makes one thread; same as RAYON_NUM_THREADS=1).
+    if rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build_global()
+        .is_err()
+    {
+        eprintln!("fit_pipeline: rayon's pool was already built; the figures may use more threads");
+    }
+    eprintln!(
+        "fit_pipeline: rayon threads = {}",
+        rayon::current_num_threads()
+    );
     let rows: usize = std::env::var("GAITFIT_BENCH_ROWS")
         .ok()
         .and_then(|s| s.parse().ok())

@@ -155,6 +155,7 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
         let flags: BTreeMap<usize, &str> =
             t.flagged.iter().map(|(r, s)| (*r, s.as_str())).collect();
         let wcol = weights.and_then(|w| weight_column(t, w));
+        let mut subj_of_table: Vec<Option<usize>> = vec![None; t.subjects.len()];
         for i in 0..t.len() {
             match t.gait[i] {
                 Some(g) if g == rel.gait() => {}
@@ -203,13 +204,25 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
             for out in 0..rel.outputs() {
                 match rel.observe_output(&row, out) {
                     Ok(o) => {
-                        let name = t.subject_name(i);
-                        let k = match subj_index.get(name) {
-                            Some(&k) => k,
+                        // The table's subject id → ours, looked up by name once per id (not
+                        // once per row: a string map per row was a fifth of this function).
+                        let ts = t.subject[i] as usize;
+                        let k = match subj_of_table.get(ts).copied().flatten() {
+                            Some(k) => k,
                             None => {
-                                let k = p.subjects.len();
-                                p.subjects.push(name.to_string());
-                                subj_index.insert(name.to_string(), k);
+                                let name = t.subject_name(i);
+                                let k = match subj_index.get(name) {
+                                    Some(&k) => k,
+                                    None => {
+                                        let k = p.subjects.len();
+                                        p.subjects.push(name.to_string());
+                                        subj_index.insert(name.to_string(), k);
+                                        k
+                                    }
+                                };
+                                if let Some(slot) = subj_of_table.get_mut(ts) {
+                                    *slot = Some(k);
+                                }
                                 k
                             }
                         };
