@@ -934,7 +934,11 @@ mod tests {
         for a in xs {
             assert_eq!(from_ordered_bits(ordered_bits(a)).to_bits(), a.to_bits());
             for b in xs {
-                assert_eq!(ordered_bits(a).cmp(&ordered_bits(b)), a.total_cmp(&b), "{a} {b}");
+                assert_eq!(
+                    ordered_bits(a).cmp(&ordered_bits(b)),
+                    a.total_cmp(&b),
+                    "{a} {b}"
+                );
             }
         }
     }
