@@ -39,6 +39,7 @@ pub enum Command {
 /// Runs the command line; returns the process exit code (0 success, 1 check failed or error,
 /// 2 usage error).
 pub fn main() -> ExitCode {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Fit(a) => fit::run(a),
@@ -54,4 +55,24 @@ pub fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Makes `gaitfit ... | head` end quietly: when the reader of standard output goes away,
+/// `println!` panics with "failed printing to stdout: Broken pipe"; like `cat`, gaitfit then
+/// stops without a panic message (exit status 0, the reader got all it asked for). Files being
+/// written are unaffected: they go through `fsio::write_atomic`, which never leaves half a file.
+fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let msg = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") && msg.contains("Broken pipe") {
+            std::process::exit(0);
+        }
+        default(info)
+    }));
 }
