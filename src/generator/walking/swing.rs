@@ -228,6 +228,9 @@ pub struct SwingRun {
 
 const TOL: f64 = 1e-8;
 
+/// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
+const MIN_TRAVEL: f64 = 0.3;
+
 impl SwingSpec<'_> {
     /// The kinematic swing foot of this swing.
     pub fn swing_foot(&self) -> SwingFoot {
@@ -320,7 +323,28 @@ impl SwingSpec<'_> {
                 th4 = hi;
             }
         }
-        let (_, a1) = self.joints(t1, &[self.theta3_hs, th4]);
+        let (_, mut a1) = self.joints(t1, &[self.theta3_hs, th4]);
+        // A short step (the first half step from standing) would leave the ankle behind its
+        // toe-off position with the toe under the knee: the knee then flexes less, so that the
+        // ankle has covered at least MIN_TRAVEL of its way to heel strike by t1.
+        let (_, a_hs) = self.joints(self.times[3], &[self.theta3_hs, 0.0]);
+        let d_min = MIN_TRAVEL * (a_hs[0] - a0[0]);
+        if a1[0] - a0[0] < d_min && d_min > 0.0 {
+            let travel = |k4: f64| self.joints(t1, &[self.theta3_hs, k4]).1[0] - a0[0] - d_min;
+            let (mut lo, mut hi) = (0.0, th4);
+            if travel(lo) > 0.0 {
+                for _ in 0..60 {
+                    let m = 0.5 * (lo + hi);
+                    if travel(m) > 0.0 {
+                        lo = m;
+                    } else {
+                        hi = m;
+                    }
+                }
+                th4 = lo;
+                a1 = self.joints(t1, &[self.theta3_hs, th4]).1;
+            }
+        }
         let d = a1[0] - a0[0];
         if d.is_nan() || d <= 0.0 {
             return Err(format!(
