@@ -206,8 +206,10 @@ attributes! {
     elbow_flexion_deg: 15.0, [0.0, 90.0], "deg";
     /// Fraction of the pelvic rotation counter-rotated by the thoracic spine and shoulders.
     spine_compensation: 1.0, [0.0, 2.0], "1";
-    /// Largest integration step (the stability bound may make it smaller).
-    max_step_s: 0.002, [0.0001, 0.01], "s";
+    /// Largest integration step (the stability bound may make it smaller). 4 ms: the shooting
+    /// absorbs the integration error into the forces, which then differ by at most 0.2 % from a
+    /// 0.5 ms integration (5 km/h, h = 1.8 m), at an eighth of the cost.
+    max_step_s: 0.004, [0.0001, 0.01], "s";
 }
 
 #[cfg(test)]

@@ -184,6 +184,44 @@ impl Determinants {
         let a = self.half_width;
         [a * sp, -2.0 * a * cp * self.list_at(t).sin()]
     }
+
+    /// [`Determinants::swing_hip_offset`] and its first and second time derivatives, analytic
+    /// (the swing dynamics read the swing hip's acceleration).
+    pub fn swing_hip_offset_rates(&self, t: f64) -> ([f64; 2], [f64; 2], [f64; 2]) {
+        let a = self.half_width;
+        let s = t / self.duration;
+        let inside = (0.0..=1.0).contains(&s);
+        let w = PI / self.duration;
+        let (s1, c1) = (PI * s.clamp(0.0, 1.0)).sin_cos();
+        let (s2, c2) = (2.0 * PI * s.clamp(0.0, 1.0)).sin_cos();
+        let (pa, pb) = (
+            if self.from_rest { 0.0 } else { -self.rotation },
+            if self.to_rest { 0.0 } else { self.rotation },
+        );
+        let psi = pa + (pb - pa) * 0.5 * (1.0 - c1);
+        let lam = self.list * 0.5 * (1.0 - c2);
+        let (psi1, psi2, lam1, lam2) = if inside {
+            (
+                (pb - pa) * 0.5 * w * s1,
+                (pb - pa) * 0.5 * w * w * c1,
+                self.list * w * s2,
+                self.list * 2.0 * w * w * c2,
+            )
+        } else {
+            (0.0, 0.0, 0.0, 0.0)
+        };
+        let (sp, cp) = psi.sin_cos();
+        let (sl, cl) = lam.sin_cos();
+        let pos = [a * sp, -2.0 * a * cp * sl];
+        let vel = [a * cp * psi1, -2.0 * a * (-sp * psi1 * sl + cp * cl * lam1)];
+        let acc = [
+            a * (cp * psi2 - sp * psi1 * psi1),
+            -2.0 * a
+                * (-cp * psi1 * psi1 * sl - sp * psi2 * sl - 2.0 * sp * psi1 * cl * lam1
+                    + cp * (-sl * lam1 * lam1 + cl * lam2)),
+        ];
+        (pos, vel, acc)
+    }
 }
 
 struct StepData {
@@ -412,14 +450,11 @@ pub fn generate_steps(
         };
         let swing_hip = |t: f64| -> HipMotion {
             let mut h = dyn_hip(t);
-            let e = 1e-4;
-            let o = det.swing_hip_offset(t);
-            let op = det.swing_hip_offset(t + e);
-            let om = det.swing_hip_offset(t - e);
+            let (o, od, odd) = det.swing_hip_offset_rates(t);
             for i in 0..2 {
                 h.pos[i] += o[i];
-                h.vel[i] += (op[i] - om[i]) / (2.0 * e);
-                h.acc[i] += (op[i] - 2.0 * o[i] + om[i]) / (e * e);
+                h.vel[i] += od[i];
+                h.acc[i] += odd[i];
             }
             h
         };
@@ -841,6 +876,19 @@ mod tests {
                 let o = d.swing_offset(t);
                 let a = d.swing_hip_offset(t);
                 assert!((a[0] - o.x).abs() < 1e-12 && (a[1] - 2.0 * o.y).abs() < 1e-12);
+            }
+            // The analytic rates against central differences.
+            for k in 1..20 {
+                let t = 0.56 * k as f64 / 20.0;
+                let e = 1e-4;
+                let (p, v, a) = d.swing_hip_offset_rates(t);
+                let (pp, pm) = (d.swing_hip_offset(t + e), d.swing_hip_offset(t - e));
+                let o = d.swing_hip_offset(t);
+                for i in 0..2 {
+                    assert!((p[i] - o[i]).abs() < 1e-15);
+                    assert!((v[i] - (pp[i] - pm[i]) / (2.0 * e)).abs() < 1e-7);
+                    assert!((a[i] - (pp[i] - 2.0 * o[i] + pm[i]) / (e * e)).abs() < 1e-4);
+                }
             }
             // Rotation: swing hip behind at the start, ahead at heel strike; list 0 at both.
             assert!(d.swing_hip_offset(0.0)[0] < 0.0 && d.swing_hip_offset(0.56)[0] > 0.0);

@@ -97,6 +97,41 @@ pub struct VirtualLeg {
     pub transitions: [Option<f64>; 3],
 }
 
+/// The root of `g` between `pos` (`g > 0`) and `neg` (`g ≤ 0`), to 1e-10, returned from the
+/// `g ≤ 0` side: the Illinois variant of regula falsi (superlinear, a handful of evaluations of
+/// the leg's geometry instead of bisection's thirty-odd), bisecting whenever it stalls.
+fn root_nonpositive_side(g: &impl Fn(f64) -> f64, pos: f64, neg: f64) -> f64 {
+    let (mut a, mut ga) = (pos, g(pos));
+    let (mut b, mut gb) = (neg, g(neg));
+    let mut side = 0i8;
+    for _ in 0..100 {
+        if (b - a).abs() < 1e-10 || gb == 0.0 {
+            break;
+        }
+        let mut m = (a * gb - b * ga) / (gb - ga);
+        if !(m.is_finite() && (m - a) * (m - b) < 0.0) {
+            m = 0.5 * (a + b);
+        }
+        let gm = g(m);
+        if gm > 0.0 {
+            a = m;
+            ga = gm;
+            if side == 1 {
+                gb *= 0.5;
+            }
+            side = 1;
+        } else {
+            b = m;
+            gb = gm;
+            if side == -1 {
+                ga *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    b
+}
+
 impl VirtualLeg {
     /// Evaluates the leg for the hip at `hip` (x, y) with lateral offset `dz` for roll `rho`.
     pub fn pose_at(&self, hip: [f64; 2], dz: f64, rho: f64) -> LegPose {
@@ -149,18 +184,7 @@ impl VirtualLeg {
                 break;
             }
         }
-        for _ in 0..50 {
-            let m = 0.5 * (a + b);
-            if g(m) > 0.0 {
-                a = m;
-            } else {
-                b = m;
-            }
-            if b - a < 1e-10 {
-                break;
-            }
-        }
-        b
+        root_nonpositive_side(&g, a, b)
     }
 
     /// Advances the rules to time `t` (leg clock) with the hip at `hip` and lateral offset `dz`
@@ -179,22 +203,11 @@ impl VirtualLeg {
                 self.rho = 0.0;
                 self.transitions[0] = Some(t);
             } else {
-                let (mut a, mut b) = (-1.2, 0.0);
+                let a = -1.2;
                 if g(a) > 0.0 {
                     self.rho = a;
                 } else {
-                    for _ in 0..60 {
-                        let m = 0.5 * (a + b);
-                        if g(m) > 0.0 {
-                            b = m;
-                        } else {
-                            a = m;
-                        }
-                        if b - a < 1e-10 {
-                            break;
-                        }
-                    }
-                    self.rho = a.max(self.rho);
+                    self.rho = root_nonpositive_side(&g, 0.0, a).max(self.rho);
                 }
                 let mut p = self.pose_at(hip, dz, self.rho);
                 p.period = self.period;
