@@ -288,3 +288,22 @@ fn run_tflight_sf_continuous_matches_a_substituted_normal_equation_fit() {
         jump.value
     );
 }
+
+/// Noise-free data: the breakpoint F-test is F = ∞ (RSS 0 with the breakpoint, > 0 without); the
+/// breakpoint must be fitted, not held at the published value as a "degenerate" test.
+#[test]
+fn run_sl_v_on_exact_data_fits_v_norm() {
+    let t = table(SyntheticSpec {
+        rows: 600,
+        subjects: 4,
+        seed: 5,
+        sl_noise: 0.0,
+        level: 0.0,
+        ..Default::default()
+    });
+    let rel = RunSlV::published();
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
+    let c = o.record.coefficient("v_norm").unwrap();
+    assert!(c.held.is_none(), "v_norm held: {:?}", c.held);
+    assert!((c.value - 400.0).abs() < 10.0, "v_norm {}", c.value);
+}

@@ -40,8 +40,13 @@ pub fn t_quantile(p: f64, df: f64) -> f64 {
 
 /// Two-sided p-value of a t statistic with `df` degrees of freedom: `2·P(T > |t|)`.
 pub fn t_two_sided_p(t: f64, df: f64) -> f64 {
-    if !t.is_finite() || !(df > 0.0) {
+    if t.is_nan() || !(df > 0.0) {
         return f64::NAN;
+    }
+    // |t| = ∞ is the limit p = 0 (e.g. a breakpoint F-test on noise-free data, RSS = 0 with the
+    // breakpoint): certain evidence, not a degenerate test.
+    if t.is_infinite() {
+        return 0.0;
     }
     match StudentsT::new(0.0, 1.0, df) {
         Ok(d) => (2.0 * d.sf(t.abs())).min(1.0),
@@ -389,6 +394,16 @@ pub fn resample_indices(n: usize, seed: u64, stream: u64) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn p_value_limits() {
+        // |t| = ∞ (noise-free data) is p = 0, not NaN; NaN and df ≤ 0 stay NaN.
+        assert_eq!(t_two_sided_p(f64::INFINITY, 10.0), 0.0);
+        assert_eq!(t_two_sided_p(f64::NEG_INFINITY, 10.0), 0.0);
+        assert!(t_two_sided_p(f64::NAN, 10.0).is_nan());
+        assert!(t_two_sided_p(1.0, 0.0).is_nan());
+        assert!((t_two_sided_p(0.0, 10.0) - 1.0).abs() < 1e-12);
+    }
 
     #[test]
     fn quantiles_match_tables() {
