@@ -109,6 +109,25 @@ fn walk_tds_sf_is_the_closed_form_simple_regression() {
         "se(d1)",
     );
     close(o.record.rmse, (rss / n).sqrt(), "rmse");
+    // Leave-one-subject-out: the closed form on the other subjects, each subject predicted.
+    let subjects: std::collections::BTreeSet<&str> = d.iter().map(|v| v.2.as_str()).collect();
+    assert!(subjects.len() >= 3);
+    let mut sq = 0.0;
+    for s in &subjects {
+        let train: Vec<_> = d.iter().filter(|v| v.2 != *s).collect();
+        let m = train.len() as f64;
+        let mx = train.iter().map(|v| v.0[0]).sum::<f64>() / m;
+        let my = train.iter().map(|v| v.1).sum::<f64>() / m;
+        let sxx: f64 = train.iter().map(|v| (v.0[0] - mx).powi(2)).sum();
+        let sxy: f64 = train.iter().map(|v| (v.0[0] - mx) * (v.1 - my)).sum();
+        let (b1, b0) = (sxy / sxx, my - sxy / sxx * mx);
+        sq += d
+            .iter()
+            .filter(|v| v.2 == *s)
+            .map(|v| (v.1 - b0 - b1 * v.0[0]).powi(2))
+            .sum::<f64>();
+    }
+    close(o.record.loso_rmse.unwrap(), (sq / n).sqrt(), "loso rmse");
 }
 
 #[test]

@@ -371,6 +371,95 @@ impl Layout {
     }
 }
 
+/// Leave-one-subject-out for a fit with only linear coefficients to refit and no per-subject
+/// columns: every subject's weighted normal equations from one pass, each fold solved from the
+/// sums of the others (prefix + suffix over subjects, so no subtraction and no pass per fold).
+/// Per subject, in subject order: the squared prediction errors of its rows (level 0), or
+/// `None` when the fold is singular — what [`leave_one_group_out`] with a refit per fold gives.
+fn loso_from_subject_sums(
+    rel: &dyn Relation,
+    lay: &Layout,
+    p: &[f64],
+    prep: &Prepared,
+    n_subj: usize,
+) -> Vec<Option<Vec<f64>>> {
+    let nc = lay.ncols();
+    let m = nc * nc + nc + 1;
+    // Per subject: XᵀWX (lower triangle by first index, as in `solve_ne`), XᵀWy, yᵀWy.
+    let mut sums = vec![0.0f64; n_subj * m];
+    let mut idx = [0usize; 17];
+    let mut val = [0.0f64; 17];
+    for (i, o) in prep.obs.iter().enumerate() {
+        let s = prep.subject[i];
+        let (k, off) = lay.row(rel, p, o, s, &mut idx, &mut val);
+        let w = prep.weights[i];
+        let y = o.y - off;
+        let acc = &mut sums[s * m..(s + 1) * m];
+        acc[m - 1] += w * y * y;
+        for a in 0..k {
+            let wa = w * val[a];
+            let ia = idx[a];
+            acc[nc * nc + ia] += wa * y;
+            for b in 0..=a {
+                acc[ia * nc + idx[b]] += wa * val[b];
+            }
+        }
+    }
+    let add = |into: &mut [f64], from: &[f64]| into.iter_mut().zip(from).for_each(|(a, b)| *a += b);
+    let mut prefix = vec![0.0f64; (n_subj + 1) * m];
+    for s in 0..n_subj {
+        let (head, tail) = prefix.split_at_mut((s + 1) * m);
+        tail[..m].copy_from_slice(&head[s * m..]);
+        add(&mut tail[..m], &sums[s * m..(s + 1) * m]);
+    }
+    let mut suffix = vec![0.0f64; (n_subj + 1) * m];
+    for s in (0..n_subj).rev() {
+        let (head, tail) = suffix.split_at_mut((s + 1) * m);
+        head[s * m..].copy_from_slice(&tail[..m]);
+        add(&mut head[s * m..], &sums[s * m..(s + 1) * m]);
+    }
+    let mut rows_of = vec![Vec::new(); n_subj];
+    for (i, &s) in prep.subject.iter().enumerate() {
+        rows_of[s].push(i);
+    }
+    let (g, shift) = lay.output_map(rel, p);
+    (0..n_subj)
+        .map(|s| {
+            let mut acc = prefix[s * m..(s + 1) * m].to_vec();
+            add(&mut acc, &suffix[(s + 1) * m..(s + 2) * m]);
+            let mut xtx = vec![0.0f64; nc * nc];
+            for a in 0..nc {
+                for b in 0..nc {
+                    xtx[a * nc + b] = if a == b {
+                        acc[a * nc + a]
+                    } else {
+                        acc[a * nc + b] + acc[b * nc + a]
+                    };
+                }
+            }
+            let (beta, _) = solve_normal(nc, &xtx, &acc[nc * nc..nc * nc + nc], acc[m - 1])?;
+            let out = &g * &beta + &shift;
+            let mut q = p.to_vec();
+            let mut j = 0;
+            for (i, spec) in rel.parameters().iter().enumerate() {
+                if spec.kind == ParamKind::Linear {
+                    q[i] = out[j];
+                    j += 1;
+                }
+            }
+            Some(
+                rows_of[s]
+                    .iter()
+                    .map(|&i| {
+                        let o = &prep.obs[i];
+                        (o.y - rel.predict_with(&q, 0.0, &o.x)).powi(2)
+                    })
+                    .collect(),
+            )
+        })
+        .collect()
+}
+
 /// Normal-equation solve on a subset of rows: (coefficients, weighted RSS). Used for profiling,
 /// cross-validation and the bootstrap; the reported fit uses QR.
 fn solve_ne(
@@ -876,6 +965,14 @@ pub fn fit_relation(
                         Some(rows_of[s].iter().map(|&i| sq_err(&q, i)).collect())
                     })
                     .collect::<Vec<Option<Vec<f64>>>>()
+                    .into_iter()
+                    .flatten()
+                    .collect()
+            }
+            // Nothing but linear coefficients to refit, and a plan that does not depend on the
+            // rows: a fold's normal equations are the other subjects' sums, all from one pass.
+            None if n_bp == 0 && lay.subj_col.is_none() && rel.plan(&[]) == plan => {
+                loso_from_subject_sums(rel, &lay, &p, &prep, n_subj)
                     .into_iter()
                     .flatten()
                     .collect()
