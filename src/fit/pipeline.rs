@@ -988,8 +988,13 @@ pub fn fit_relation(
             (
                 Some((sq.iter().sum::<f64>() / sq.len() as f64).sqrt()),
                 format!(
-                    "{n_subj} folds; each subject predicted (level 0) from a full refit, \
-                     breakpoints included, on the others"
+                    "{n_subj} folds; each subject predicted (level 0) from a full refit{}, on \
+                     the others",
+                    if n_bp > 0 {
+                        ", breakpoints included"
+                    } else {
+                        ""
+                    }
                 ),
             )
         } else {
