@@ -192,7 +192,7 @@ pub const SPECS: [AttrSpec; 19] = [
         doc: "stance knee flexion at mid-support (pelvis low point); rises with flight height" },
     AttrSpec { attr: Attr::Overstride, name: "overstride", unit: AttrUnit::Metres, min: 0.0, max: 0.4, default: 0.03,
         couplings: &[Coupling { driver: Driver::Speed, reference: V_REF, slope: -0.006, range: ALL_RANGE }],
-        doc: "heel ahead of the pelvis at impact; falls with speed" },
+        doc: "heel ahead of the pelvis at impact (the least: long supports land further ahead); falls with speed" },
     AttrSpec { attr: Attr::StrideWidth, name: "stride_width", unit: AttrUnit::Metres, min: 0.0, max: 0.4, default: SW_REF, couplings: &[],
         doc: "lateral distance between the feet's centre lines" },
     AttrSpec { attr: Attr::KneeHeelStrike, name: "knee_heel_strike", unit: AttrUnit::Degrees, min: 0.0, max: 70.0 * D, default: 15.0 * D, couplings: &[],

@@ -15,7 +15,7 @@ use argmin::solver::gaussnewton::GaussNewton;
 use glam::{DVec2, DVec3};
 use nalgebra::{Matrix2, Vector2};
 
-use super::attributes::{Effective, Strike};
+use super::attributes::{hidden_impact_pitch, Effective, Strike};
 use super::curves::{c2_mid_velocity, Key, KneeBump, Seg3, Track};
 use super::dims::{leg_fk, leg_ik, pelvis_matrix, pitch_from_down, rot2, LegAngles, RunnerDims};
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, stance_leg_in, StanceMode};
@@ -218,6 +218,9 @@ pub struct StepReport {
     pub clearance_keys: u32,
     /// The stance hip stayed out of reach somewhere despite recovery 1.
     pub out_of_reach: bool,
+    /// Overstride of the landing that ends the step, m (the attribute, or more for a long
+    /// support).
+    pub overstride: f64,
     /// Hind-leg fraction p.
     pub p: f64,
 }
@@ -457,6 +460,15 @@ pub const STOP_TIME: f64 = 0.6;
 /// sprinters' support is about 40 % of the step.
 pub const MIN_STANCE_FRACTION: f64 = 0.25;
 
+/// Longest overstride the landing may be moved ahead to for long supports, m at 1.8 m (the
+/// attribute's range).
+pub const OVERSTRIDE_MAX: f64 = 0.4;
+
+/// Toe-off leg lean (hip ahead of the toe tip, from the vertical) beyond which a long support
+/// moves the landing ahead, rad. Real runners leave the ground at about 30–40°; the published
+/// relations' runs stay at or under 26°, so they are unaffected.
+pub const TOE_OFF_LEAN_MAX: f64 = 30.0 * std::f64::consts::PI / 180.0;
+
 /// Least downward speed of the landing foot's lowest point at heel strike, m/s at 1.8 m.
 pub const LANDING_SPEED: f64 = 0.15;
 
@@ -586,6 +598,9 @@ pub struct StateKeys {
     pub yaw2: f64,
     /// Pelvic list at heel strike, rad.
     pub roll2: f64,
+    /// Heel of the next footprint ahead of the pelvis at its heel strike, m: the overstride
+    /// attribute, or more for a long support (see [`TOE_OFF_LEAN_MAX`]).
+    pub overstride: f64,
 }
 
 /// Computes the state keyframes for a step whose stance foot (side sign `s`) is planted at
@@ -600,33 +615,40 @@ pub fn state_keyframes(
     let e = inp.eff;
     let (v, sl, sf) = (inp.speed, inp.step_length, inp.step_freq);
     let t_step = 1.0 / sf;
-    // --- Heel strike at the end of the step (HSL), bottom-up. ---
-    let next_print = Footprint {
-        heel: DVec3::new(fp.heel.x + sl, 0.0, -s * e.stride_width / 2.0),
-        strike: e.strike,
-        impact_pitch: e.impact_pitch,
-    };
     let (rot_max, list_max, lat_max) = (e.pelvic_rotation, e.pelvic_list, e.lateral_displacement);
     // Fig. 7: at heel strike 20 % rotation (landing hip forward), 80 % list (swing side down),
     // 80 % lateral displacement toward the landing foot.
     let (yaw2, roll2, z2) = (-s * 0.2 * rot_max, s * 0.8 * list_max, -s * 0.8 * lat_max);
-    let x2 = next_print.heel.x - e.overstride;
-    let a2 = next_print.impact_ankle(d);
     let o2 = pelvis_matrix(yaw2, roll2) * d.hip_local(-s);
-    let dd2 = d.hip_ankle(e.knee_heel_strike);
-    let (dx2, dz2) = (x2 + o2.x - a2.x, z2 + o2.z - a2.z);
-    let r2 = dd2 * dd2 - dx2 * dx2 - dz2 * dz2;
-    if r2 <= 0.0 {
-        return Err(GenerateError::Parameter {
-            name: "overstride".into(),
-            value: e.overstride,
-            message: format!(
-                "the landing leg cannot reach its heel {:.3} m ahead and {:.3} m aside of the hip; lower overstride or stride width",
-                -dx2, dz2.abs()
-            ),
-        });
-    }
-    let y2 = a2.y + r2.sqrt() - o2.y;
+    let scale = d.body_height / 1.8;
+    // --- Heel strike at the end of the step (HSL), bottom-up, for a landing `os` ahead. ---
+    let landing = |os: f64| -> Result<(Footprint, f64, f64), GenerateError> {
+        let next_print = Footprint {
+            heel: DVec3::new(fp.heel.x + sl, 0.0, -s * e.stride_width / 2.0),
+            strike: e.strike,
+            impact_pitch: if os > e.overstride {
+                hidden_impact_pitch(os / scale, e.strike)
+            } else {
+                e.impact_pitch
+            },
+        };
+        let x2 = next_print.heel.x - os;
+        let a2 = next_print.impact_ankle(d);
+        let dd2 = d.hip_ankle(e.knee_heel_strike);
+        let (dx2, dz2) = (x2 + o2.x - a2.x, z2 + o2.z - a2.z);
+        let r2 = dd2 * dd2 - dx2 * dx2 - dz2 * dz2;
+        if r2 <= 0.0 {
+            return Err(GenerateError::Parameter {
+                name: "overstride".into(),
+                value: os,
+                message: format!(
+                    "the landing leg cannot reach its heel {:.3} m ahead and {:.3} m aside of the hip; lower overstride or stride width",
+                    -dx2, dz2.abs()
+                ),
+            });
+        }
+        Ok((next_print, x2, a2.y + r2.sqrt() - o2.y))
+    };
 
     // --- Toe off of the stance leg (TOR), backwards from HSL. ---
     let x_toe = fp.heel.x + d.foot_length();
@@ -636,7 +658,7 @@ pub fn state_keyframes(
     let rad = toe_off_radius(d, e.knee_toe_off, e.ankle_toe_off, e.meta_toe_off, dz1).ok_or_else(|| {
         numerical("toe-off leg", format!("the hip is {dz1:.3} m aside of the foot, beyond the leg; lower stride width or lateral displacement"))
     })?;
-    let case_one = |t_f: f64| -> Result<(f64, f64), GenerateError> {
+    let case_one = |x2: f64, t_f: f64| -> Result<(f64, f64), GenerateError> {
         // Eq. 7: x1 = x2 − v·t_flight; eq. 8: y1 = √(rad² − (x1 − x_toe)²), for the hip.
         let x1 = x2 - v * t_f;
         let xh = x1 + o1.x - x_toe;
@@ -651,14 +673,48 @@ pub fn state_keyframes(
         }
         Ok((x1, (rad * rad - xh * xh).sqrt() - o1.y))
     };
+    // Long supports (a refitted eq. 5's short flights at high speed: 1.1 m of ground in 0.22 s
+    // at 18 km/h) cannot all be covered behind the toe: the toe-off hip would sink (0.69 m vs
+    // 1.02 m with the published flights). Real runners then land further ahead. The paper keeps
+    // overstride an attribute; here, with the flight time given (case I), the landing moves
+    // ahead (the attribute stays the least overstride) until the pelvis takes off no lower than
+    // it lands (the take-off of an unforced flight), or the toe-off leg leans no more than
+    // TOE_OFF_LEAN_MAX; the published relations never lean it further (≤ 26° over 2–25 km/h).
+    let mut os = e.overstride;
+    if let FlightSpec::Time(t_f) = inp.flight {
+        let gap = |os: f64| match landing(os) {
+            Err(_) => f64::INFINITY,
+            Ok((_, x2, y2)) => match case_one(x2, t_f) {
+                Ok((x1, y1)) => (y1 - y2).max(rad * TOE_OFF_LEAN_MAX.sin() - (x1 + o1.x - x_toe)),
+                Err(_) if x2 - v * t_f + o1.x > x_toe => f64::NEG_INFINITY,
+                Err(_) => f64::INFINITY,
+            },
+        };
+        if gap(os) < 0.0 {
+            let (mut lo, mut hi) = (os, OVERSTRIDE_MAX * scale);
+            if gap(hi) >= 0.0 {
+                for _ in 0..50 {
+                    let mid = 0.5 * (lo + hi);
+                    if gap(mid) < 0.0 {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                // The reachable side of the bracket, so that the landing leg reaches its heel.
+                os = if gap(hi).is_finite() { hi } else { lo };
+            }
+        }
+    }
+    let (next_print, x2, y2) = landing(os)?;
     let (x1, y1, t_flight, case) = match inp.flight {
         FlightSpec::Time(t_f) => {
-            let (x1, y1) = case_one(t_f)?;
+            let (x1, y1) = case_one(x2, t_f)?;
             (x1, y1, t_f, FlightCase::I)
         }
         FlightSpec::Height(h) => {
             let guess_t = 0.5 * t_step;
-            let (gx, gy) = case_one(guess_t).unwrap_or((x2 - v * guess_t, rad * 0.99));
+            let (gx, gy) = case_one(x2, guess_t).unwrap_or((x2 - v * guess_t, rad * 0.99));
             let (x1, y1) = solve_case_two(
                 CaseTwo {
                     rad,
@@ -706,6 +762,7 @@ pub fn state_keyframes(
         yaw1,
         yaw2,
         roll2,
+        overstride: os,
     })
 }
 
@@ -743,6 +800,7 @@ pub fn plan_step(
         yaw1,
         yaw2,
         roll2,
+        overstride,
     } = k;
     let (x1, y1, z1) = (p1.x, p1.y, p1.z);
     let (list_max, lat_max) = (e.pelvic_list, e.lateral_displacement);
@@ -817,6 +875,7 @@ pub fn plan_step(
             takeoff_vy: w,
             rad,
             p: inp.p,
+            overstride,
             ..StepReport::default()
         },
     };
