@@ -14,7 +14,10 @@ use std::process::ExitCode;
     long_about = "Refit the published gait relations (running 1996 eqs. 2, 4–5; walking 1989 eq. 1 \
 and the t_ds formula) on per-step trials tables, with full statistics.\n\n\
 Input: CSV trials tables with a unit in every numeric header (see data/README.md), e.g. \
-subject,gait,speed_m_per_s,step_length_m,step_freq_steps_per_min,flight_time_s,body_height_m. \
+subject,gait,speed_m_per_s,step_length_m,step_freq_steps_per_min,flight_time_s,body_height_m; \
+or raw measured files (.c3d, .trc with its .forces/_grf.mot, .mot GRF, .forces, WBDS *grf.txt, \
+Winter's table, a per-frame CSV without subject/gait columns, a folder of them, or \
+MARKERS+FORCES), whose steps are first derived as `gaitfit events` does with its defaults. \
 Rows lacking what a relation needs, or whose speed, step length and step frequency disagree by \
 more than 2 %, are rejected and reported, never silently used.\n\n\
 Output: fits/<id>.json and fits/<id>.toml per relation (coefficients with standard errors, 95 % \
@@ -28,10 +31,12 @@ Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk
 pooled with each μ centred on its own mean; per-μ statistics are listed as derived).",
     after_help = "Examples:\n  gaitfit fit                                   # data/*.csv, all relations\n  \
 gaitfit fit --data my_trials.csv --relation run-sl-v\n  \
+gaitfit fit --data ../shared/data/wbds --relation walk-sl-sf walk-tds-sf\n  \
 gaitfit fit --robust --bootstrap 1000 --seed 7"
 )]
 pub struct Args {
-    /// Trials tables (CSV) to fit on, fitted together. Default: every data/*.csv.
+    /// Trials tables (CSV) or raw measured files / folders (events are detected first), fitted
+    /// together. Default: every data/*.csv.
     #[arg(long = "data", value_name = "FILE", num_args = 1..)]
     pub data: Vec<PathBuf>,
     /// Relation id(s) to fit. Default: all (relations with no usable rows are skipped).
@@ -78,6 +83,27 @@ fn default_data() -> anyhow::Result<Vec<PathBuf>> {
     Ok(v)
 }
 
+/// Trials tables as they are; raw measured files (C3D, TRC + forces, treadmill GRF, folders of
+/// them, a per-frame CSV recognised by its header) through the events layer, in the given order.
+fn load_inputs(paths: &[PathBuf]) -> anyhow::Result<Vec<crate::ingest::trials::TrialsTable>> {
+    use crate::events::input::{is_raw_input, raw_step_rows};
+    let mut tables = Vec::with_capacity(paths.len());
+    for p in paths {
+        if crate::fit::pipeline::is_trials_table(p) && is_raw_input(p) {
+            // A per-frame CSV: load_tables routes every .csv to the trials reader.
+            let rows = raw_step_rows(p)?;
+            let mut t = crate::ingest::trials::TrialsTable::from_step_rows(p, &rows);
+            if let Ok(bytes) = std::fs::read(p) {
+                t.sha256 = crate::ingest::trials::sha256_hex(&bytes);
+            }
+            tables.push(t);
+        } else {
+            tables.extend(load_tables(std::slice::from_ref(p), Some(raw_step_rows))?);
+        }
+    }
+    Ok(tables)
+}
+
 /// Runs `gaitfit fit`.
 pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     let paths = if args.data.is_empty() {
@@ -93,7 +119,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             .map(|id| by_id(id))
             .collect::<Result<_, _>>()?
     };
-    let tables = load_tables(&paths, None)?;
+    let tables = load_inputs(&paths)?;
     let opts = FitOptions {
         robust: args.robust,
         weights: args.weights.clone(),

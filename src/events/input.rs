@@ -157,3 +157,40 @@ pub fn steps_from_path(
     }
     Ok(table)
 }
+
+/// The raw-file hook of `gaitfit fit` ([`crate::fit::pipeline::RawStepReader`]): reads a
+/// measured file, a folder of them or an `A+B` pair with the default reading and event
+/// options (metadata such as belt speed and body height from the files themselves) and returns
+/// its per-step rows.
+pub fn raw_step_rows(path: &Path) -> crate::Result<Vec<crate::ingest::trials::StepRow>> {
+    let table = steps_from_path(path, &ReadOptions::default(), &EventOptions::default())?;
+    Ok(table.rows)
+}
+
+/// Whether `path` is a measured file for the events layer rather than a trials table: anything
+/// but `.csv`, and a `.csv` whose header (first line not starting with `#`) has neither a
+/// `subject` nor a `gait` column — gaitfit's per-frame CSV ([`crate::ingest::frame_csv`]); a
+/// trials table needs both columns, so no trials table is mistaken for a raw file.
+pub fn is_raw_input(path: &Path) -> bool {
+    if path.is_dir() || ext(path) != "csv" {
+        return true;
+    }
+    use std::io::BufRead;
+    // Unreadable: let the trials reader report it with its own message.
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    let Some(header) = std::io::BufReader::new(file)
+        .lines()
+        .map_while(Result::ok)
+        .map(|l| l.trim_start_matches('\u{feff}').trim().to_string())
+        .find(|l| !l.is_empty() && !l.starts_with('#'))
+    else {
+        return false;
+    };
+    let cols: Vec<String> = header
+        .split(',')
+        .map(|c| c.trim().trim_matches('"').to_ascii_lowercase())
+        .collect();
+    !cols.iter().any(|c| c == "subject" || c == "gait")
+}

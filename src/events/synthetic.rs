@@ -256,4 +256,52 @@ impl SyntheticGait {
         trial.plates = plates;
         trial
     }
+
+    /// The trial as gaitfit's per-frame CSV ([`crate::ingest::frame_csv`]): markers in mm and
+    /// one plate per foot (`l_belt`, `r_belt`, N) at the marker rate, with the belt speed and
+    /// the subject in `#` settings lines — a raw file for `gaitfit fit --data` and the readers.
+    pub fn frame_csv(&self) -> String {
+        use std::fmt::Write as _;
+        let trial = SyntheticGait {
+            force_rate_hz: self.marker_rate_hz,
+            ..self.clone()
+        }
+        .trial();
+        let mut s = format!(
+            "# gait = {}\n# vertical = y\n# forward = +x\n# belt_speed_m_per_s = {}\n\
+             # subject = synthetic\n# body_height_m = 1.8\n# leg_length_m = 0.95\ntime_s",
+            if self.duty_factor > 0.5 {
+                "walk"
+            } else {
+                "run"
+            },
+            self.belt_speed_m_per_s
+        );
+        let Some(m) = trial.markers.as_ref() else {
+            return s;
+        };
+        for name in &m.names {
+            let _ = write!(s, ",{name}_x_mm,{name}_y_mm,{name}_z_mm");
+        }
+        for p in &trial.plates {
+            let side = if p.side == Some(Side::Left) { "l" } else { "r" };
+            let _ = write!(s, ",{side}_belt_fx_n,{side}_belt_fy_n,{side}_belt_fz_n");
+        }
+        s.push('\n');
+        for (f, t) in m.time_s.iter().enumerate() {
+            let _ = write!(s, "{t:.6}");
+            for traj in &m.positions {
+                for v in traj[f] {
+                    let _ = write!(s, ",{:.3}", v * 1000.0);
+                }
+            }
+            for p in &trial.plates {
+                for v in p.force_n.get(f).copied().unwrap_or([0.0; 3]) {
+                    let _ = write!(s, ",{v:.3}");
+                }
+            }
+            s.push('\n');
+        }
+        s
+    }
 }
