@@ -119,6 +119,10 @@ fn writes_steps_comparison_and_plots_from_a_folder() {
     }
     let plot = std::fs::read_to_string(dir.path().join("plots/trials_walk.svg")).unwrap();
     assert!(plot.starts_with("<svg") && plot.contains("polyline"));
+    let png = std::fs::read(dir.path().join("plots/trials_walk.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG\r\n\x1a\n"), "not a PNG");
+    // A drawn figure, not a blank canvas: many distinct bytes after compression.
+    assert!(png.len() > 10_000, "{} bytes", png.len());
 }
 
 #[test]

@@ -74,3 +74,33 @@ fn synthetic_run() {
     // rounds that corner and moves the maximum earlier, more so for the short running step.
     check(&SyntheticGait::run(), Gait::Run, 40.0);
 }
+
+#[test]
+fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
+    let g = SyntheticGait::walk();
+    let mut trial = g.trial();
+    trial.plates.clear();
+    let opts = EventOptions::default();
+    // Markers only: the Zeni coordinate events build the steps.
+    let an = analyse(&trial, &opts).unwrap();
+    assert_eq!(an.events.primary, EventSource::ZeniCoordinate);
+    // With the file's own events (a C3D EVENT group), those are used and kept as they are.
+    trial.reference_events = g
+        .events()
+        .into_iter()
+        .map(|mut e| {
+            e.source = EventSource::Reference;
+            e
+        })
+        .collect();
+    let an = analyse(&trial, &opts).unwrap();
+    assert_eq!(an.events.primary, EventSource::Reference);
+    assert_eq!(an.events.reference, trial.reference_events);
+    let t = steps_from_analysis(&trial, &an, &opts).unwrap();
+    let ds: Vec<f64> = t.rows.iter().filter_map(|r| r.double_support_time_s).collect();
+    assert!(ds.len() > 10, "{} steps with double support", ds.len());
+    let expect = (g.duty_factor - 0.5) * g.stride_time_s;
+    for d in ds {
+        assert!((d - expect).abs() < 1e-6, "double support {d} vs {expect}");
+    }
+}

@@ -31,7 +31,8 @@ pub struct Args {
     /// file's reference events (`reference`): detection F1 and timing error per event type.
     #[arg(long, value_name = "force|reference")]
     pub compare: Option<String>,
-    /// Write one check plot (SVG) per trial into this folder.
+    /// Write one check plot per trial into this folder, as SVG and PNG (vertical GRF and
+    /// heel/toe traces with the events marked).
     #[arg(long, value_name = "DIR")]
     pub plots: Option<std::path::PathBuf>,
     /// Print a per-trial summary (steps, cadence, step length, stance, double support/flight).
@@ -40,8 +41,8 @@ pub struct Args {
     /// Print what the readers and the detection assumed or found, per trial (to stderr).
     #[arg(short, long)]
     pub verbose: bool,
-    /// Which events build the steps: auto (force with per-foot plates, else Zeni), force,
-    /// zeni, zeni-velocity, reference.
+    /// Which events build the steps: auto (force with per-foot plates, else the file's own
+    /// events, else Zeni), force, zeni, zeni-velocity, reference.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
     pub events: String,
     /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
@@ -151,11 +152,12 @@ fn process(
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
         let name = if parent.is_empty() {
-            format!("{stem}.svg")
+            stem
         } else {
-            format!("{parent}_{stem}.svg")
+            format!("{parent}_{stem}")
         };
-        crate::events::plot::write_svg(&dir.join(name), &an)?;
+        crate::events::plot::write_svg(&dir.join(format!("{name}.svg")), &an)?;
+        crate::events::plot::write_png(&dir.join(format!("{name}.png")), &an)?;
     }
     let mut notes = trial.notes.clone();
     notes.extend(an.events.notes.iter().cloned());

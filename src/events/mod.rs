@@ -141,8 +141,8 @@ pub enum EventError {
 #[serde(rename_all = "snake_case")]
 pub enum PrimarySource {
     /// Force-plate events when every contact of both feet falls on a plate (per-foot plates:
-    /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the Zeni coordinate method;
-    /// otherwise the file's reference events.
+    /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the file's reference events
+    /// (C3D EVENT group); otherwise the Zeni coordinate method.
     #[default]
     Auto,
     /// Force-plate events only.
@@ -352,12 +352,17 @@ fn choose_primary(
         PrimarySource::FootHeight => need(EventSource::FootMarkers, "the foot-marker heights"),
         PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
         PrimarySource::Auto => {
+            // The file's own events come before the Zeni estimate: on the shared overground
+            // data the Zeni heel strike precedes the force-plate contact by 30–40 ms (the heel
+            // still travels forward in the ground frame after its largest lead on the pelvis),
+            // which lengthens stance and double support by as much; the laboratories' events
+            // (Schreiber & Moissenet 2019) agree with the plates to a frame (reports/events.md).
             if ev.force_complete && has_both_kinds(&ev.force) {
                 Ok(EventSource::Force)
-            } else if has_both_kinds(&ev.zeni_coordinate) {
-                Ok(EventSource::ZeniCoordinate)
             } else if has_both_kinds(&ev.reference) {
                 Ok(EventSource::Reference)
+            } else if has_both_kinds(&ev.zeni_coordinate) {
+                Ok(EventSource::ZeniCoordinate)
             } else if has_both_kinds(&ev.force) {
                 Ok(EventSource::Force)
             } else {
@@ -379,9 +384,10 @@ pub fn steps_from_trial(trial: &Trial, opts: &EventOptions) -> Result<StepTable,
 }
 
 impl Analysis {
-    /// Compares the kinematic methods (Zeni coordinate and velocity) with the force-plate
-    /// events (`reference = Force`) or with the file's reference events (`Reference`), over the
-    /// time both cover. Returns an empty table when either side has no events.
+    /// Compares the kinematic methods (Zeni coordinate and velocity, foot heights) with the
+    /// force-plate events (`reference = Force`; then also the file's own events, as
+    /// `file_events`) or with the file's reference events (`Reference`), over the time both
+    /// cover. Returns an empty table when either side has no events.
     pub fn compare(&self, reference: EventSource, tol_s: f64) -> compare::CompareTable {
         let mut table = compare::CompareTable::default();
         let refs = self.events.of(reference);
@@ -411,8 +417,10 @@ impl Analysis {
                 (f64::NEG_INFINITY, f64::INFINITY),
             ),
         };
-        span.0 = span.0.max(k.time_s[0]);
-        span.1 = span.1.min(k.time_s[k.time_s.len() - 1]);
+        // An extremum cannot be seen at the very edge of the marker record: reference events
+        // within the tolerance of either end are not judged (they would count as misses).
+        span.0 = span.0.max(k.time_s[0] + tol_s);
+        span.1 = span.1.min(k.time_s[k.time_s.len() - 1] - tol_s);
         let rname = match reference {
             EventSource::Force => "force",
             _ => "reference",
@@ -424,6 +432,11 @@ impl Analysis {
         ] {
             let res = compare::compare(det, refs, coverage, span, tol_s);
             table.add(name, rname, &res);
+        }
+        // The file's own events against the plates: what justifies building steps from them.
+        if reference == EventSource::Force && !self.events.reference.is_empty() {
+            let res = compare::compare(&self.events.reference, refs, coverage, span, tol_s);
+            table.add("file_events", rname, &res);
         }
         table
     }
