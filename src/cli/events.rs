@@ -171,6 +171,10 @@ fn process(
 }
 
 fn mean_sd(v: &[f64]) -> String {
+    mean_sd_prec(v, 3)
+}
+
+fn mean_sd_prec(v: &[f64], digits: usize) -> String {
     if v.is_empty() {
         return "–".into();
     }
@@ -181,12 +185,12 @@ fn mean_sd(v: &[f64]) -> String {
     } else {
         0.0
     };
-    format!("{m:.3}±{sd:.3}")
+    format!("{m:.digits$}±{sd:.digits$}")
 }
 
 fn summary(results: &[TrialResult]) -> String {
     let mut s = format!(
-        "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
+        "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
         "trial",
         "gait",
         "steps",
@@ -195,6 +199,7 @@ fn summary(results: &[TrialResult]) -> String {
         "step len m",
         "stance s",
         "dbl supp s",
+        "dbl supp %",
         "flight s"
     );
     for r in results {
@@ -212,7 +217,7 @@ fn summary(results: &[TrialResult]) -> String {
             .rev()
             .collect();
         s.push_str(&format!(
-            "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
+            "{:<44} {:>4} {:>5} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13} {:>13}\n",
             label,
             rows.first()
                 .and_then(|x| x.gait)
@@ -224,6 +229,7 @@ fn summary(results: &[TrialResult]) -> String {
             mean_sd(&col(&|x| x.step_length_m)),
             mean_sd(&col(&|x| x.stance_time_s)),
             mean_sd(&col(&|x| x.double_support_time_s)),
+            mean_sd_prec(&col(&|x| x.double_support_pct_cycle), 1),
             mean_sd(&col(&|x| x.flight_time_s)),
         ));
     }

@@ -142,7 +142,9 @@ pub enum EventError {
 pub enum PrimarySource {
     /// Force-plate events when every contact of both feet falls on a plate (per-foot plates:
     /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the file's reference events
-    /// (C3D EVENT group); otherwise the Zeni coordinate method.
+    /// (C3D EVENT group); otherwise the force events if the plates saw at least two steps
+    /// (successive heel strikes of opposite feet, no contact beside the plates in between:
+    /// an overground walkway); otherwise the Zeni coordinate method.
     #[default]
     Auto,
     /// Force-plate events only.
@@ -323,6 +325,31 @@ pub fn detect(trial: &Trial, opts: &EventOptions) -> Result<TrialEvents, EventEr
     analyse(trial, opts).map(|a| a.events)
 }
 
+/// Steps the force events describe: successive heel strikes of opposite feet. `None` when a
+/// pair of them encloses a heel strike the markers saw (`kinematic`: a contact beside the
+/// plates), since the per-step table would then take a stride and a half for a step.
+fn force_steps(ev: &[GaitEvent], kinematic: &[GaitEvent]) -> Option<usize> {
+    let heel_strikes = |v: &[GaitEvent]| -> Vec<(f64, Side)> {
+        let mut h: Vec<(f64, Side)> = v
+            .iter()
+            .filter(|e| e.kind == EventKind::HeelStrike)
+            .map(|e| (e.time_s, e.side))
+            .collect();
+        h.sort_by(|a, b| a.0.total_cmp(&b.0));
+        h
+    };
+    let (hs, kin) = (heel_strikes(ev), heel_strikes(kinematic));
+    let mut n = 0;
+    for w in hs.windows(2).filter(|w| w[0].1 != w[1].1) {
+        // 0.1 s: well beyond the kinematic methods' timing error, well below a step.
+        if kin.iter().any(|k| k.0 > w[0].0 + 0.1 && k.0 < w[1].0 - 0.1) {
+            return None;
+        }
+        n += 1;
+    }
+    Some(n)
+}
+
 fn has_both_kinds(ev: &[GaitEvent]) -> bool {
     ev.iter().any(|e| e.kind == EventKind::HeelStrike)
         && ev.iter().any(|e| e.kind == EventKind::ToeOff)
@@ -361,6 +388,12 @@ fn choose_primary(
                 Ok(EventSource::Force)
             } else if has_both_kinds(&ev.reference) {
                 Ok(EventSource::Reference)
+            } else if has_both_kinds(&ev.force)
+                && force_steps(&ev.force, &ev.zeni_coordinate).is_some_and(|n| n >= 2)
+            {
+                // Overground plates that saw at least two successive steps (BMClab's walkway):
+                // fewer steps than the markers give, but timed by the plates.
+                Ok(EventSource::Force)
             } else if has_both_kinds(&ev.zeni_coordinate) {
                 Ok(EventSource::ZeniCoordinate)
             } else if has_both_kinds(&ev.force) {
@@ -439,5 +472,34 @@ impl Analysis {
             table.add("file_events", rname, &res);
         }
         table
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hs(t: f64, side: Side, source: EventSource) -> GaitEvent {
+        GaitEvent {
+            time_s: t,
+            side,
+            kind: EventKind::HeelStrike,
+            source,
+        }
+    }
+
+    #[test]
+    fn force_steps_counts_alternating_strikes_and_refuses_a_missed_contact() {
+        use EventSource::{Force, ZeniCoordinate as Z};
+        use Side::{Left as L, Right as R};
+        let kin = vec![hs(0.17, L, Z), hs(0.70, R, Z), hs(1.26, L, Z), hs(1.82, R, Z)];
+        let force = vec![hs(0.21, L, Force), hs(0.75, R, Force), hs(1.31, L, Force)];
+        assert_eq!(force_steps(&force, &kin), Some(2));
+        // The right contact at 0.70 s missed the plates: L 0.21 → L 1.31 is skipped as a
+        // same-foot pair, but L 1.31 → R 1.85 is fine, and L 0.21 → R 1.85 would not be.
+        let force = vec![hs(0.21, L, Force), hs(1.31, L, Force), hs(1.85, R, Force)];
+        assert_eq!(force_steps(&force, &kin), Some(1));
+        let force = vec![hs(0.21, L, Force), hs(1.85, R, Force)];
+        assert_eq!(force_steps(&force, &kin), None);
     }
 }
