@@ -136,12 +136,14 @@ fn vertical_axis(trial: &Trial) -> usize {
         .unwrap_or(1)
 }
 
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
+/// The `p` quantile (nearest rank) of `v`, which it reorders: a selection, O(n), instead of a
+/// sort (a 30 s plate at 1 kHz has 30 000 samples).
+fn percentile(v: &mut [f64], p: f64) -> f64 {
+    if v.is_empty() {
         return f64::NAN;
     }
-    let k = ((sorted.len() - 1) as f64 * p).round() as usize;
-    sorted[k.min(sorted.len() - 1)]
+    let k = (((v.len() - 1) as f64 * p).round() as usize).min(v.len() - 1);
+    *v.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
 /// Filters the vertical force of `plate` and removes its unloaded baseline.
@@ -174,16 +176,15 @@ pub fn vertical_force(
         });
     }
     let mut f = filtfilt_gappy(&filter, &raw);
-    let mut sorted: Vec<f64> = f.iter().copied().filter(|v| v.is_finite()).collect();
-    sorted.sort_by(f64::total_cmp);
-    let (p2, p98) = (percentile(&sorted, 0.02), percentile(&sorted, 0.98));
+    let mut finite: Vec<f64> = f.iter().copied().filter(|v| v.is_finite()).collect();
+    let (p2, p98) = (percentile(&mut finite, 0.02), percentile(&mut finite, 0.98));
     let mut report = PlateReport {
         name: plate.name.clone(),
         offset_n: 0.0,
         drift_n: 0.0,
         contacts: 0,
     };
-    if sorted.is_empty() {
+    if finite.is_empty() {
         return Ok((f, report));
     }
     if p98 < opts.on_n && p2 < -opts.on_n {
