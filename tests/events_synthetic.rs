@@ -97,7 +97,11 @@ fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
     assert_eq!(an.events.primary, EventSource::Reference);
     assert_eq!(an.events.reference, trial.reference_events);
     let t = steps_from_analysis(&trial, &an, &opts).unwrap();
-    let ds: Vec<f64> = t.rows.iter().filter_map(|r| r.double_support_time_s).collect();
+    let ds: Vec<f64> = t
+        .rows
+        .iter()
+        .filter_map(|r| r.double_support_time_s)
+        .collect();
     assert!(ds.len() > 10, "{} steps with double support", ds.len());
     let expect = (g.duty_factor - 0.5) * g.stride_time_s;
     for d in ds {

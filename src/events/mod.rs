@@ -492,7 +492,12 @@ mod tests {
     fn force_steps_counts_alternating_strikes_and_refuses_a_missed_contact() {
         use EventSource::{Force, ZeniCoordinate as Z};
         use Side::{Left as L, Right as R};
-        let kin = vec![hs(0.17, L, Z), hs(0.70, R, Z), hs(1.26, L, Z), hs(1.82, R, Z)];
+        let kin = vec![
+            hs(0.17, L, Z),
+            hs(0.70, R, Z),
+            hs(1.26, L, Z),
+            hs(1.82, R, Z),
+        ];
         let force = vec![hs(0.21, L, Force), hs(0.75, R, Force), hs(1.31, L, Force)];
         assert_eq!(force_steps(&force, &kin), Some(2));
         // The right contact at 0.70 s missed the plates: L 0.21 → L 1.31 is skipped as a

@@ -418,7 +418,14 @@ mod png {
             let v = p.v0 + (p.v1 - p.v0) * k as f64 / 4.0;
             let y = p.y(v);
             line(a, vec![(px(LEFT - 4.0), px(y)), (px(LEFT), px(y))], grey, 1)?;
-            text(a, &format!("{v:.2}"), LEFT - 6.0, y + 5.0, 11.0, HPos::Right)?;
+            text(
+                a,
+                &format!("{v:.2}"),
+                LEFT - 6.0,
+                y + 5.0,
+                11.0,
+                HPos::Right,
+            )?;
         }
         let span = p.t1 - p.t0;
         let dt = [0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0]
@@ -504,7 +511,11 @@ mod png {
             v0: -0.05 * fmax,
             v1: 1.05 * fmax,
         };
-        axes(a, &pf, "vertical ground reaction force, N (filtered, baseline removed)")?;
+        axes(
+            a,
+            &pf,
+            "vertical ground reaction force, N (filtered, baseline removed)",
+        )?;
         for v in &an.force.vertical {
             let c = v.side.map(colour).unwrap_or("#555555");
             trace(a, &pf, &v.time_s, &v.force_n, rgb(c))?;
@@ -513,7 +524,14 @@ mod png {
         ticks(a, &pf, &an.events.reference, true)?;
         let pm_y0 = TOP + PANEL_H + GAP;
         let Some(k) = &an.kinematics else {
-            return text(a, "no markers in this trial", LEFT, pm_y0 + 20.0, 13.0, HPos::Left);
+            return text(
+                a,
+                "no markers in this trial",
+                LEFT,
+                pm_y0 + 20.0,
+                13.0,
+                HPos::Left,
+            );
         };
         let mut lines: Vec<(Vec<f64>, RGBColor)> = Vec::new();
         for side in [Side::Left, Side::Right] {
