@@ -96,6 +96,13 @@ fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
     let an = analyse(&trial, &opts).unwrap();
     assert_eq!(an.events.primary, EventSource::Reference);
     assert_eq!(an.events.reference, trial.reference_events);
+    // A generator's own events (a generated motion read back) do not replace detection.
+    let mut generated = trial.clone();
+    for e in &mut generated.reference_events {
+        e.source = EventSource::Generated;
+    }
+    let g_an = analyse(&generated, &opts).unwrap();
+    assert_eq!(g_an.events.primary, EventSource::ZeniCoordinate);
     let t = steps_from_analysis(&trial, &an, &opts).unwrap();
     let ds: Vec<f64> = t
         .rows

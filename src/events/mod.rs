@@ -141,10 +141,12 @@ pub enum EventError {
 #[serde(rename_all = "snake_case")]
 pub enum PrimarySource {
     /// Force-plate events when every contact of both feet falls on a plate (per-foot plates:
-    /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the file's reference events
-    /// (C3D EVENT group); otherwise the force events if the plates saw at least two steps
+    /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the file's measured reference
+    /// events (C3D EVENT group; not a generator's own events); otherwise the force events if
+    /// the plates saw at least two steps
     /// (successive heel strikes of opposite feet, no contact beside the plates in between:
-    /// an overground walkway); otherwise the Zeni coordinate method.
+    /// an overground walkway); otherwise the Zeni coordinate method; otherwise the file's
+    /// events whatever their origin.
     #[default]
     Auto,
     /// Force-plate events only.
@@ -350,6 +352,13 @@ fn force_steps(ev: &[GaitEvent], kinematic: &[GaitEvent]) -> Option<usize> {
     Some(n)
 }
 
+/// Whether the file's events were measured (a laboratory's C3D events) rather than written by
+/// a generator: a generated motion's own events are its ground truth, and detecting events on
+/// it is the point of reading it back (closing the loop), so they do not replace detection.
+fn measured(ev: &[GaitEvent]) -> bool {
+    ev.iter().all(|e| e.source != EventSource::Generated)
+}
+
 fn has_both_kinds(ev: &[GaitEvent]) -> bool {
     ev.iter().any(|e| e.kind == EventKind::HeelStrike)
         && ev.iter().any(|e| e.kind == EventKind::ToeOff)
@@ -386,7 +395,7 @@ fn choose_primary(
             // (Schreiber & Moissenet 2019) agree with the plates to a frame (reports/events.md).
             if ev.force_complete && has_both_kinds(&ev.force) {
                 Ok(EventSource::Force)
-            } else if has_both_kinds(&ev.reference) {
+            } else if has_both_kinds(&ev.reference) && measured(&ev.reference) {
                 Ok(EventSource::Reference)
             } else if has_both_kinds(&ev.force)
                 && force_steps(&ev.force, &ev.zeni_coordinate).is_some_and(|n| n >= 2)
@@ -396,6 +405,8 @@ fn choose_primary(
                 Ok(EventSource::Force)
             } else if has_both_kinds(&ev.zeni_coordinate) {
                 Ok(EventSource::ZeniCoordinate)
+            } else if has_both_kinds(&ev.reference) {
+                Ok(EventSource::Reference)
             } else if has_both_kinds(&ev.force) {
                 Ok(EventSource::Force)
             } else {
