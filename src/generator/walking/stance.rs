@@ -91,8 +91,12 @@ pub struct StanceRun {
 }
 
 impl StanceSpec {
-    fn forces(&self, t: f64, y: &[f64; 7], a: f64, sub: Sub, ext: (f64, f64, f64)) -> [f64; 3] {
-        let f1 = if t < self.torque_off { a } else { 0.0 };
+    /// Generalized forces; `f1` is the step torque's value on the current segment (`A` before
+    /// `torque_off`, 0 after), fixed per integration segment rather than read from `t`: the last
+    /// RK4 stage of the segment ending at `torque_off` is evaluated at `t + h`, which rounds to
+    /// either side of the switch, and a torque read from `t` there made `θ̇1` jump by `h·A/(6I)`
+    /// (a discontinuous shooting residual that stalled the solver, issue 6 / klawfix).
+    fn forces(&self, t: f64, y: &[f64; 7], f1: f64, sub: Sub, ext: (f64, f64, f64)) -> [f64; 3] {
         let f2 = -self.k2 * (y[2] - self.theta2_ref) - self.c2 * y[5];
         let pa = match sub {
             Sub::Extend => {
@@ -110,7 +114,7 @@ impl StanceSpec {
         &self,
         t: f64,
         y: &[f64; 7],
-        a: f64,
+        f1: f64,
         sub: Sub,
         ext: (f64, f64, f64),
         floor: f64,
@@ -122,7 +126,7 @@ impl StanceSpec {
         }
         let q = [y[0], y[1], y[2]];
         let qd = [y[3], y[4], y[5]];
-        let f = self.forces(t, y, a, sub, ext);
+        let f = self.forces(t, y, f1, sub, ext);
         let acc = self.model.accel(&q, &qd, &f, sub == Sub::Rigid);
         let pa_rate = match sub {
             Sub::CompressAbove | Sub::CompressBelow => {
@@ -179,8 +183,11 @@ impl StanceSpec {
         let mut lock_time = None;
         let mut extend_time = if sub == Sub::Extend { Some(0.0) } else { None };
         let mut track = Track::default();
-        let node = |spec: &StanceSpec, t: f64, y: &[f64; 7], sub: Sub, ext| {
-            let d = spec.deriv(t, y, a, sub, ext, floor);
+        // The step torque's value on the current segment (see `forces`).
+        let torque_at = |t: f64| if t < self.torque_off { a } else { 0.0 };
+        let mut f1 = torque_at(0.0);
+        let node = |spec: &StanceSpec, t: f64, y: &[f64; 7], sub: Sub, ext, f1: f64| {
+            let d = spec.deriv(t, y, f1, sub, ext, floor);
             Node {
                 t,
                 q: [y[0], y[1], y[2]],
@@ -209,7 +216,7 @@ impl StanceSpec {
                     let pa_u = if sub == Sub::Rigid {
                         let q = [y[0], y[1], y[2]];
                         let qd = [y[3], y[4], y[5]];
-                        let f = self.forces(t, &y, a, sub, ext);
+                        let f = self.forces(t, &y, f1, sub, ext);
                         self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
                     } else {
                         y[6]
@@ -242,16 +249,17 @@ impl StanceSpec {
             } else {
                 self.duration
             };
+            f1 = torque_at(t);
             if record {
-                track.push(node(self, t, &y, sub, ext));
+                track.push(node(self, t, &y, sub, ext, f1));
             }
             let spec = *self;
-            let mut f = |tt: f64, yy: &[f64; 7]| spec.deriv(tt, yy, a, sub, ext, floor);
+            let mut f = |tt: f64, yy: &[f64; 7]| spec.deriv(tt, yy, f1, sub, ext, floor);
             let mut ev = |_tt: f64, yy: &[f64; 7]| event_value(sub, yy);
             let mut tr: Vec<Node<3>> = Vec::new();
             let mut obs = |_t0: f64, _y0: &[f64; 7], t1: f64, y1: &[f64; 7]| {
                 if record {
-                    tr.push(node(&spec, t1, y1, sub, ext));
+                    tr.push(node(&spec, t1, y1, sub, ext, f1));
                 }
             };
             let seg = integrate(&mut f, t, y, t_end, h, Some(&mut ev), &mut obs);
@@ -261,7 +269,7 @@ impl StanceSpec {
             fired = seg.event;
         }
         if record {
-            track.push(node(self, t, &y, sub, ext));
+            track.push(node(self, t, &y, sub, ext, f1));
         }
         StanceRun {
             end: [y[0], y[1], y[2], y[3], y[4], y[5]],
