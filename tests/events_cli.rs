@@ -2,78 +2,18 @@
 //! TRC + OpenSim GRF MOT files; and the bad inputs of issue 4 (standing trial, too short, plate
 //! drift, marker gaps, missing markers) with clear errors and no partial output.
 use assert_cmd::Command;
-use gaitfit::events::synthetic::SyntheticGait;
+use gaitfit::events::synthetic::{grf_mot_text, trc_text, SyntheticGait};
 use gaitfit::events::{steps_from_trial, EventError, EventOptions};
 use gaitfit::ingest::types::{ForcePlate, MarkerSet, Trial};
-use std::fmt::Write as _;
 use std::path::Path;
 
 fn write_trc(path: &Path, m: &MarkerSet) {
-    let n = m.len();
-    let k = m.names.len();
-    let mut s = String::new();
-    let _ = writeln!(s, "PathFileType\t4\t(X/Y/Z)\t{}", path.display());
-    let _ = writeln!(
-        s,
-        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames"
-    );
-    let _ = writeln!(s, "{0}\t{0}\t{n}\t{k}\tmm\t{0}\t1\t{n}", m.rate_hz);
-    let mut names = String::from("Frame#\tTime");
-    let mut axes = String::from("\t");
-    for (i, name) in m.names.iter().enumerate() {
-        let _ = write!(names, "\t{name}\t\t");
-        let _ = write!(axes, "\tX{0}\tY{0}\tZ{0}", i + 1);
-    }
-    let _ = writeln!(s, "{names}\n{axes}\n");
-    for f in 0..n {
-        let _ = write!(s, "{}\t{:.5}", f + 1, m.time_s[f]);
-        for t in &m.positions {
-            for v in t[f] {
-                if v.is_finite() {
-                    let _ = write!(s, "\t{:.4}", v * 1000.0);
-                } else {
-                    s.push('\t');
-                }
-            }
-        }
-        s.push('\n');
-    }
-    std::fs::write(path, s).unwrap();
+    std::fs::write(path, trc_text(&path.display().to_string(), m)).unwrap();
 }
 
 fn write_grf_mot(path: &Path, plates: &[ForcePlate]) {
-    let (r, l) = (&plates[1], &plates[0]);
-    let n = r.time_s.len();
-    let mut s = format!(
-        "name {}\ndatacolumns 19\ndatarows {n}\nrange {} {}\nendheader\ntime",
-        path.display(),
-        r.time_s[0],
-        r.time_s[n - 1]
-    );
-    for side in ["R", "L"] {
-        for q in ["vx", "vy", "vz", "px", "py", "pz"] {
-            let _ = write!(s, "\t{side}_ground_force_{q}");
-        }
-    }
-    for side in ["R", "L"] {
-        for q in ["x", "y", "z"] {
-            let _ = write!(s, "\t{side}_ground_torque_{q}");
-        }
-    }
-    s.push('\n');
-    for i in 0..n {
-        let _ = write!(s, "{:.4}", r.time_s[i]);
-        for p in [r, l] {
-            for v in p.force_n[i] {
-                let _ = write!(s, "\t{v:.3}");
-            }
-            for v in p.cop_m[i] {
-                let _ = write!(s, "\t{:.5}", if v.is_finite() { v } else { 0.0 });
-            }
-        }
-        s.push_str("\t0\t0\t0\t0\t0\t0\n");
-    }
-    std::fs::write(path, s).unwrap();
+    let text = grf_mot_text(&path.display().to_string(), &plates[1], &plates[0]);
+    std::fs::write(path, text).unwrap();
 }
 
 fn write_trial(dir: &Path, stem: &str, t: &Trial) {

@@ -308,74 +308,92 @@ impl SyntheticGait {
     /// The markers as an OpenSim TRC file (mm, tab-separated), for reading benchmarks and tests
     /// of the readers: save it as `X.trc` beside [`Self::grf_mot`] saved as `X_grf.mot`.
     pub fn trc(&self) -> String {
-        use std::fmt::Write as _;
         let trial = self.trial();
-        let Some(m) = trial.markers.as_ref() else {
-            return String::new();
-        };
-        let (n, k) = (m.len(), m.names.len());
-        let mut s = String::from("PathFileType\t4\t(X/Y/Z)\tsynthetic.trc\n");
-        s.push_str(
-            "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t\
-             OrigDataStartFrame\tOrigNumFrames\n",
-        );
-        let _ = writeln!(s, "{0}\t{0}\t{n}\t{k}\tmm\t{0}\t1\t{n}", m.rate_hz);
-        let mut names = String::from("Frame#\tTime");
-        let mut axes = String::from("\t");
-        for (i, name) in m.names.iter().enumerate() {
-            let _ = write!(names, "\t{name}\t\t");
-            let _ = write!(axes, "\tX{0}\tY{0}\tZ{0}", i + 1);
-        }
-        let _ = writeln!(s, "{names}\n{axes}\n");
-        for f in 0..n {
-            let _ = write!(s, "{}\t{:.5}", f + 1, m.time_s[f]);
-            for traj in &m.positions {
-                for v in traj[f] {
-                    let _ = write!(s, "\t{:.4}", v * 1000.0);
-                }
-            }
-            s.push('\n');
-        }
-        s
+        trial
+            .markers
+            .as_ref()
+            .map_or_else(String::new, |m| trc_text("synthetic.trc", m))
     }
 
     /// The two belts as an OpenSim GRF `.mot` file (`R_ground_force_*`, `L_ground_force_*`).
     pub fn grf_mot(&self) -> String {
-        use std::fmt::Write as _;
         let trial = self.trial();
         let plate = |side| trial.plates.iter().find(|p| p.side == Some(side));
         let (Some(r), Some(l)) = (plate(Side::Right), plate(Side::Left)) else {
             return String::new();
         };
-        let n = r.time_s.len();
-        let mut s = format!(
-            "name synthetic_grf.mot\ndatacolumns 19\ndatarows {n}\nrange {} {}\nendheader\ntime",
-            r.time_s.first().copied().unwrap_or(0.0),
-            r.time_s.last().copied().unwrap_or(0.0)
-        );
-        for side in ["R", "L"] {
-            for q in ["vx", "vy", "vz", "px", "py", "pz"] {
-                let _ = write!(s, "\t{side}_ground_force_{q}");
-            }
-        }
-        for side in ["R", "L"] {
-            for q in ["x", "y", "z"] {
-                let _ = write!(s, "\t{side}_ground_torque_{q}");
+        grf_mot_text("synthetic_grf.mot", r, l)
+    }
+}
+
+/// Markers as an OpenSim TRC file (mm, tab-separated; a missing sample — NaN — is an empty
+/// cell, as TRC writers leave gaps). `name` goes in the header. Used by the synthetic trials,
+/// the benches and the tests that write trials to disk.
+pub fn trc_text(name: &str, m: &MarkerSet) -> String {
+    use std::fmt::Write as _;
+    let (n, k) = (m.len(), m.names.len());
+    let mut s = format!("PathFileType\t4\t(X/Y/Z)\t{name}\n");
+    s.push_str(
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\t\
+         OrigDataStartFrame\tOrigNumFrames\n",
+    );
+    let _ = writeln!(s, "{0}\t{0}\t{n}\t{k}\tmm\t{0}\t1\t{n}", m.rate_hz);
+    let mut names = String::from("Frame#\tTime");
+    let mut axes = String::from("\t");
+    for (i, name) in m.names.iter().enumerate() {
+        let _ = write!(names, "\t{name}\t\t");
+        let _ = write!(axes, "\tX{0}\tY{0}\tZ{0}", i + 1);
+    }
+    let _ = writeln!(s, "{names}\n{axes}\n");
+    for f in 0..n {
+        let _ = write!(s, "{}\t{:.5}", f + 1, m.time_s[f]);
+        for traj in &m.positions {
+            for v in traj[f] {
+                if v.is_finite() {
+                    let _ = write!(s, "\t{:.4}", v * 1000.0);
+                } else {
+                    s.push('\t');
+                }
             }
         }
         s.push('\n');
-        for i in 0..n {
-            let _ = write!(s, "{:.4}", r.time_s[i]);
-            for p in [r, l] {
-                for v in p.force_n[i] {
-                    let _ = write!(s, "\t{v:.3}");
-                }
-                for v in p.cop_m[i] {
-                    let _ = write!(s, "\t{:.5}", if v.is_finite() { v } else { 0.0 });
-                }
-            }
-            s.push_str("\t0\t0\t0\t0\t0\t0\n");
-        }
-        s
     }
+    s
+}
+
+/// Two force plates (right, left) as an OpenSim GRF `.mot` file (`R_ground_force_*`,
+/// `L_ground_force_*`, torques zero; a missing centre of pressure is written as 0). `name` goes
+/// in the header.
+pub fn grf_mot_text(name: &str, r: &ForcePlate, l: &ForcePlate) -> String {
+    use std::fmt::Write as _;
+    let n = r.time_s.len();
+    let mut s = format!(
+        "name {name}\ndatacolumns 19\ndatarows {n}\nrange {} {}\nendheader\ntime",
+        r.time_s.first().copied().unwrap_or(0.0),
+        r.time_s.last().copied().unwrap_or(0.0)
+    );
+    for side in ["R", "L"] {
+        for q in ["vx", "vy", "vz", "px", "py", "pz"] {
+            let _ = write!(s, "\t{side}_ground_force_{q}");
+        }
+    }
+    for side in ["R", "L"] {
+        for q in ["x", "y", "z"] {
+            let _ = write!(s, "\t{side}_ground_torque_{q}");
+        }
+    }
+    s.push('\n');
+    for i in 0..n {
+        let _ = write!(s, "{:.4}", r.time_s[i]);
+        for p in [r, l] {
+            for v in p.force_n[i] {
+                let _ = write!(s, "\t{v:.3}");
+            }
+            for v in p.cop_m[i] {
+                let _ = write!(s, "\t{:.5}", if v.is_finite() { v } else { 0.0 });
+            }
+        }
+        s.push_str("\t0\t0\t0\t0\t0\t0\n");
+    }
+    s
 }
