@@ -427,16 +427,7 @@ fn loso_from_subject_sums(
         .map(|s| {
             let mut acc = prefix[s * m..(s + 1) * m].to_vec();
             add(&mut acc, &suffix[(s + 1) * m..(s + 2) * m]);
-            let mut xtx = vec![0.0f64; nc * nc];
-            for a in 0..nc {
-                for b in 0..nc {
-                    xtx[a * nc + b] = if a == b {
-                        acc[a * nc + a]
-                    } else {
-                        acc[a * nc + b] + acc[b * nc + a]
-                    };
-                }
-            }
+            let xtx = symmetric_xtx(nc, &acc);
             let (beta, _) = solve_normal(nc, &xtx, &acc[nc * nc..nc * nc + nc], acc[m - 1])?;
             let out = &g * &beta + &shift;
             let mut q = p.to_vec();
@@ -499,17 +490,7 @@ fn solve_ne(
         Some(r) => r.iter().for_each(|&i| add(i)),
         None => (0..prep.obs.len()).for_each(&mut add),
     }
-    let mut xtx = vec![0.0f64; nc * nc];
-    for a in 0..nc {
-        for b in 0..nc {
-            // Entries were accumulated in either triangle depending on column order.
-            xtx[a * nc + b] = if a == b {
-                acc[a * nc + a]
-            } else {
-                acc[a * nc + b] + acc[b * nc + a]
-            };
-        }
-    }
+    let xtx = symmetric_xtx(nc, &acc);
     solve_normal(nc, &xtx, &aty, yty)
 }
 
@@ -1342,4 +1323,20 @@ pub fn fit_all(
         }
     }
     run
+}
+
+/// The full XᵀX (row-major nc × nc) from sums accumulated in either triangle (entries are added
+/// in whichever order the columns came; the diagonal once).
+fn symmetric_xtx(nc: usize, acc: &[f64]) -> Vec<f64> {
+    let mut xtx = vec![0.0f64; nc * nc];
+    for a in 0..nc {
+        for b in 0..nc {
+            xtx[a * nc + b] = if a == b {
+                acc[a * nc + a]
+            } else {
+                acc[a * nc + b] + acc[b * nc + a]
+            };
+        }
+    }
+    xtx
 }
