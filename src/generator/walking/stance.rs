@@ -291,16 +291,21 @@ impl StanceSpec {
             let r = self.run(start, x[0], x[1], h, false);
             [r.end[1] - self.target[1], r.end[0] - self.target[0]]
         };
-        // Without a previous step's profile (the walk's first step), a coarse scan of the step
-        // torque picks the start: the Broyden iteration needs a start near the solution, and far
-        // from it the pendulum falls (the residual saturates and the Jacobian is meaningless).
-        let guess = if guess == [0.0, 0.0] {
+        // Without a previous step's profile (the walk's first step), or when that profile is far
+        // off for this step's start (the pendulum falls: the residual saturates and the Jacobian
+        // is meaningless, so the Broyden iteration diverges), a coarse scan of the step torque
+        // picks the start: the Broyden iteration needs a start near the solution.
+        let norm = |r: [f64; 2]| (r[0] / 0.01).hypot(r[1] / 0.01);
+        let far = guess == [0.0, 0.0] || {
+            let r = f(guess);
+            !(r[0].abs() < 0.2 && r[1].abs() < 0.05)
+        };
+        let guess = if far {
             let scale = (self.model.m1 + self.model.m2) * self.model.g * self.l1;
             let mut best = (f64::INFINITY, guess);
             for i in 0..=16 {
-                let x = [scale * (0.5 * i as f64 / 16.0 - 0.05), 0.0];
-                let r = f(x);
-                let n = (r[0] / 0.01).hypot(r[1] / 0.01);
+                let x = [scale * (0.5 * i as f64 / 16.0 - 0.05), guess[1]];
+                let n = norm(f(x));
                 if n < best.0 {
                     best = (n, x);
                 }
