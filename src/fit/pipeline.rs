@@ -652,22 +652,15 @@ pub fn fit_relation(
         let Some(null) = rel.breakpoint_null(i) else {
             continue;
         };
-        let rss1 = Profiler {
+        let pr = Profiler {
             rel,
             lay: &lay,
             src,
-        }
-        .solve(&p)
-        .map_or(f64::NAN, |r| r.1);
+        };
+        let rss1 = pr.solve(&p).map_or(f64::NAN, |r| r.1);
         let mut q = p.clone();
         q[i] = null;
-        let rss0 = Profiler {
-            rel,
-            lay: &lay,
-            src,
-        }
-        .solve(&q)
-        .map_or(f64::NAN, |r| r.1);
+        let rss0 = pr.solve(&q).map_or(f64::NAN, |r| r.1);
         let df = n as f64 - n_params_max as f64;
         let f = (rss0 - rss1) / (rss1 / df);
         let pval = super::stats::t_two_sided_p(f.max(0.0).sqrt(), df);

@@ -1408,25 +1408,29 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         s * lat,
     );
     let h = 0.5 * t_stop;
+    // The mid-support velocity depends only on the ends, so recovery 1 below only moves p_mid.
     let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
-    let support = [
-        Seg3 {
-            t0: 0.0,
-            t1: h,
-            p0: carry.pelvis,
-            p1: p_mid,
-            v0: carry.pelvis_vel,
-            v1: v_mid,
-        },
-        Seg3 {
-            t0: h,
-            t1: t_stop,
-            p0: p_mid,
-            p1: p_end,
-            v0: v_mid,
-            v1: DVec3::ZERO,
-        },
-    ];
+    let support_through = |p_mid: DVec3| {
+        [
+            Seg3 {
+                t0: 0.0,
+                t1: h,
+                p0: carry.pelvis,
+                p1: p_mid,
+                v0: carry.pelvis_vel,
+                v1: v_mid,
+            },
+            Seg3 {
+                t0: h,
+                t1: t_stop,
+                p0: p_mid,
+                p1: p_end,
+                v0: v_mid,
+                v1: DVec3::ZERO,
+            },
+        ]
+    };
+    let support = support_through(p_mid);
     let t_flat = (0.12 * scale.sqrt()).min(0.4 * t_stop);
     let mut plan = StepPlan {
         kind: StepKind::Stop,
@@ -1483,25 +1487,7 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
     // out of reach.
     while !stance_reachable(&plan, d) && plan.report.mid_support_lowered < 12 {
         p_mid.y -= 0.01 * scale;
-        let v_mid = c2_mid_velocity(carry.pelvis, p_end, carry.pelvis_vel, DVec3::ZERO, h);
-        plan.support = [
-            Seg3 {
-                t0: 0.0,
-                t1: h,
-                p0: carry.pelvis,
-                p1: p_mid,
-                v0: carry.pelvis_vel,
-                v1: v_mid,
-            },
-            Seg3 {
-                t0: h,
-                t1: t_stop,
-                p0: p_mid,
-                p1: p_end,
-                v0: v_mid,
-                v1: DVec3::ZERO,
-            },
-        ];
+        plan.support = support_through(p_mid);
         plan.report.mid_support_lowered += 1;
     }
     // The swing foot: ankle from where it is now, up and forward, down onto its footprint.
