@@ -15,9 +15,11 @@
 //! 1. *compression* (telescopic, A.1): the leg shortens after heel strike (knee flexion). The
 //!    position actuator monitors the hip: while the hip is below its height at heel strike, `pa`
 //!    rises at `monitor_gain · (y_hs − y_hip)` ("if it drops too low, pa is increased").
-//! 2. *rigid* (A.1 with correction 3): when the leg regains its unloaded length `l1` before it
-//!    passes the vertical it is locked (`ẇ = 0`; the locking impulse acts along the leg, so the
-//!    generalized momenta of `θ1` and `θ2` are conserved).
+//! 2. *rigid* (A.1 with correction 3): when the leg is "too long" before it passes the vertical
+//!    — at least its unloaded length `l1` and lengthening — it is locked (`ẇ = 0`; the locking
+//!    impulse acts along the leg, so the generalized momenta of `θ1` and `θ2` are conserved).
+//!    A leg that regains `l1` from below locks at `l1`; one that landed longer than `l1` and
+//!    bottoms out above it locks where it turns.
 //! 3. *extension* (telescopic): from the event `θ1 > 0` (leg passes the vertical) the lock is
 //!    removed with `pa` set so that `F_w` equals the leg's reaction (no jump in force), and `pa`
 //!    grows as `pa_u + P·τ²` (τ the fraction of the remaining time) to extend the leg — plantar
@@ -71,8 +73,7 @@ pub struct StanceStart {
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Sub {
-    CompressAbove,
-    CompressBelow,
+    Compress,
     Rigid,
     Extend,
 }
@@ -129,9 +130,7 @@ impl StanceSpec {
         let f = self.forces(t, y, f1, sub, ext);
         let acc = self.model.accel(&q, &qd, &f, sub == Sub::Rigid);
         let pa_rate = match sub {
-            Sub::CompressAbove | Sub::CompressBelow => {
-                self.monitor_gain * (floor - y[0] * y[1].cos()).max(0.0)
-            }
+            Sub::Compress => self.monitor_gain * (floor - y[0] * y[1].cos()).max(0.0),
             _ => 0.0,
         };
         [y[3], y[4], y[5], acc[0], acc[1], acc[2], pa_rate]
@@ -174,10 +173,8 @@ impl StanceSpec {
         let mut t = 0.0;
         let mut sub = if y[1] >= 0.0 {
             Sub::Extend
-        } else if y[0] > self.l1 {
-            Sub::CompressAbove
         } else {
-            Sub::CompressBelow
+            Sub::Compress
         };
         let mut ext = (0.0, pa0, p);
         let mut lock_time = None;
@@ -197,9 +194,17 @@ impl StanceSpec {
         };
         let l1 = self.l1;
         // The middle level's event functions: a subphase ends when its function reaches 0.
+        // Compression ends with the lock ("leg too long": the leg is at least its unloaded length
+        // and lengthening, `min(w − l1, ẇ) ≥ 0`) or at the vertical (`θ1 ≥ 0`). A leg that lands
+        // longer than `l1` (eq. 3 asks for it at slow speeds) and bottoms out above `l1` is
+        // locked where it turns (ẇ = 0) instead of lengthening telescopically: that is what the
+        // paper's lock prevents ("w > l1 … too early in the stance phase"), and it keeps the
+        // end state continuous in the forces. The earlier rule (lock only on regaining `l1`
+        // from below) switched between "never locked" and "locked at l1" when the compression
+        // grazed `l1` — a jump of ≈ 0.07 rad in θ1(t_step) that no torque could shoot across
+        // (1.41 km/h, h 1.739 m; issue 6, klawshoot).
         let event_value = |sub: Sub, yy: &[f64; 7]| match sub {
-            Sub::CompressAbove => (l1 - yy[0]).max(yy[1]),
-            Sub::CompressBelow => (yy[0] - l1).max(yy[1]),
+            Sub::Compress => (yy[0] - l1).min(yy[3]).max(yy[1]),
             Sub::Rigid => yy[1],
             Sub::Extend => -1.0,
         };
@@ -224,9 +229,7 @@ impl StanceSpec {
                     ext = (t, pa_u, p);
                     extend_time = Some(t);
                     sub = Sub::Extend;
-                } else if sub == Sub::CompressAbove {
-                    sub = Sub::CompressBelow;
-                } else if sub == Sub::CompressBelow {
+                } else if sub == Sub::Compress {
                     // Lock: the impulse acts along the leg only.
                     let q = [y[0], y[1], y[2]];
                     let m = self.model.mass_matrix(&q);
@@ -317,5 +320,90 @@ impl StanceSpec {
         let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 160)?;
         let run = self.run(start, solved.x[0], solved.x[1], h, true);
         Ok((solved, run))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The pre-roll stance of a 1.41 km/h walk of a 1.739 m, 75 kg body (issue 6, klawshoot):
+    /// the leg lands 1.4 cm longer than `l1` and its compression bottoms out right at `l1` for
+    /// step torques near 76 N·m.
+    fn grazing_spec() -> (StanceSpec, StanceStart) {
+        let spec = StanceSpec {
+            model: StanceModel {
+                m1: 12.075,
+                r1: 0.4637049549994735,
+                i1: 0.9023095423237595,
+                m2: 50.85,
+                r2: 0.4086130486703893,
+                i2: 8.354852059153348,
+                g: 9.80665,
+            },
+            l1: 0.8385261392395542,
+            k_w: 17542.655275290806,
+            v_w: 755.5846565932001,
+            k2: 1700.0439705506935,
+            c2: 317.5208291826306,
+            theta2_ref: 0.03490658503988659,
+            duration: 1.0319516195325107,
+            torque_off: 0.4127806478130043,
+            monitor_gain: 20.0,
+            target: [0.8526964553305313, 0.23940226803375858],
+            max_step: 0.004,
+        };
+        let start = StanceStart {
+            q: [
+                0.8526964553305313,
+                -0.23940226803375858,
+                0.03490658503988659,
+            ],
+            qd: [-0.09291990504440535, 0.44645356106147843, 0.0],
+        };
+        (spec, start)
+    }
+
+    #[test]
+    fn end_state_is_continuous_where_the_compression_grazes_l1() {
+        let (spec, start) = grazing_spec();
+        let h = spec.step(&start);
+        let da = 0.02;
+        let mut prev: Option<[f64; 6]> = None;
+        // Leg locked above l1 (where it turned) / at l1 (regained from below).
+        let (mut above, mut at) = (0, 0);
+        let mut worst = [0.0f64; 2];
+        for i in 0..=250 {
+            let a = 74.0 + da * i as f64;
+            let r = spec.run(&start, a, 0.0, h, true);
+            let lock = r
+                .lock_time
+                .expect("the compression ends above the vertical");
+            let w = r.track.at(lock).0[0];
+            if w > spec.l1 + 1e-9 {
+                above += 1;
+            } else {
+                at += 1;
+            }
+            if let Some(p) = prev {
+                worst[0] = worst[0].max((r.end[1] - p[1]).abs());
+                worst[1] = worst[1].max((r.end[0] - p[0]).abs());
+            }
+            prev = Some(r.end);
+        }
+        // θ1(t_step) grows ≈ 0.03 rad per N·m here, so 0.02 N·m moves it ≈ 6e-4 rad; the old
+        // lock rule jumped by 0.04–0.07 rad (and 1 cm in w) where the graze flipped.
+        assert!(worst[0] < 2e-3 && worst[1] < 5e-4, "jumps {worst:?}");
+        // The scan crosses the graze.
+        assert!(above > 0 && at > 0, "locked above l1 {above}, at l1 {at}");
+    }
+
+    #[test]
+    fn the_grazing_stance_shoots_onto_its_targets() {
+        let (spec, start) = grazing_spec();
+        let (s, run) = spec.solve(&start, [0.0, 0.0]).unwrap();
+        assert!(s.residual[0].abs() <= 1e-7 && s.residual[1].abs() <= 1e-7);
+        assert!((run.end[0] - spec.target[0]).abs() <= 1e-7);
+        assert!((run.end[1] - spec.target[1]).abs() <= 1e-7);
     }
 }
