@@ -10,11 +10,20 @@ fn check(g: &SyntheticGait, gait: Gait, zeni_tol_ms: f64) {
     let an = analyse(&trial, &opts).unwrap();
     assert_eq!(an.events.primary, EventSource::Force);
     let span = (0.0, g.duration_s);
-    for (name, det, tol_ms) in [
+    let mut sources = vec![
         ("force", &an.events.force, 8.0),
         ("zeni coordinate", &an.events.zeni_coordinate, zeni_tol_ms),
         ("zeni velocity", &an.events.zeni_velocity, zeni_tol_ms),
-    ] {
+    ];
+    match gait {
+        // On the belt the synthetic foot's speed over the ground jumps from the walking speed
+        // to zero at heel strike and back at toe off (the belt velocity must be removed for
+        // that); the 6 Hz filter spreads each jump over about ±40 ms, so the 0.5 / 0.8
+        // crossings land within three frames (20 ms at 150 Hz) of the jump.
+        Gait::Walk => sources.push(("foot speed", &an.events.foot_speed, 20.0)),
+        Gait::Run => assert!(an.events.foot_speed.is_empty(), "walking detector on a run"),
+    }
+    for (name, det, tol_ms) in sources {
         let c = compare(det, &truth, Coverage::Complete, span, 0.06);
         for kind in [EventKind::HeelStrike, EventKind::ToeOff] {
             let k = &c[&kind];
@@ -81,9 +90,9 @@ fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
     let mut trial = g.trial();
     trial.plates.clear();
     let opts = EventOptions::default();
-    // Markers only: the Zeni coordinate events build the steps.
+    // Markers only, walking: the foot-speed events (Zeni windows refined) build the steps.
     let an = analyse(&trial, &opts).unwrap();
-    assert_eq!(an.events.primary, EventSource::ZeniCoordinate);
+    assert_eq!(an.events.primary, EventSource::FootSpeed);
     // With the file's own events (a C3D EVENT group), those are used and kept as they are.
     trial.reference_events = g
         .events()
@@ -102,7 +111,7 @@ fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
         e.source = EventSource::Generated;
     }
     let g_an = analyse(&generated, &opts).unwrap();
-    assert_eq!(g_an.events.primary, EventSource::ZeniCoordinate);
+    assert_eq!(g_an.events.primary, EventSource::FootSpeed);
     let t = steps_from_analysis(&trial, &an, &opts).unwrap();
     let ds: Vec<f64> = t
         .rows
@@ -114,4 +123,55 @@ fn without_per_foot_plates_the_files_own_events_come_before_zeni() {
     for d in ds {
         assert!((d - expect).abs() < 1e-6, "double support {d} vs {expect}");
     }
+}
+
+/// The same walk on a treadmill and overground (every forward coordinate plus belt speed × t):
+/// the foot-speed detector removes the belt's velocity, so it finds the same events, and the
+/// ground moves at minus the belt speed on the treadmill and stands still overground.
+#[test]
+fn foot_speed_events_are_the_same_on_a_treadmill_and_overground() {
+    use gaitfit::events::kinematic::Kinematics;
+    let g = SyntheticGait::walk();
+    let mut belt = g.trial();
+    belt.plates.clear();
+    let mut ground = belt.clone();
+    let ms = ground.markers.as_mut().unwrap();
+    let times = ms.time_s.clone();
+    for m in &mut ms.positions {
+        for (p, t) in m.iter_mut().zip(&times) {
+            p[0] += g.belt_speed_m_per_s * t;
+        }
+    }
+    let opts = EventOptions::default();
+    let a = analyse(&belt, &opts).unwrap();
+    let b = analyse(&ground, &opts).unwrap();
+    assert_eq!(a.events.primary, EventSource::FootSpeed);
+    assert_eq!(b.events.primary, EventSource::FootSpeed);
+    assert!(a.events.foot_speed.len() > 20);
+    assert_eq!(a.events.foot_speed.len(), b.events.foot_speed.len());
+    for (x, y) in a.events.foot_speed.iter().zip(&b.events.foot_speed) {
+        assert_eq!((x.side, x.kind), (y.side, y.kind));
+        // 1e-5 s: the two medians (ground, walking speed) differ in the last digits.
+        // The filter is linear and passes a ramp unchanged, except within its edge padding
+        // (about half a second) at either end of the record.
+        let interior = x.time_s > 0.5 && x.time_s < g.duration_s - 0.5;
+        let tol = if interior { 1e-9 } else { 1e-4 };
+        assert!((x.time_s - y.time_s).abs() < tol, "{x:?} vs {y:?}");
+    }
+    let speeds = |an: &gaitfit::events::Analysis| {
+        let k: &Kinematics = an.kinematics.as_ref().unwrap();
+        k.ground_and_walking_speed(&an.events.zeni_coordinate)
+            .unwrap()
+    };
+    let (gb, vb) = speeds(&a);
+    let (gg, vg) = speeds(&b);
+    let v = g.belt_speed_m_per_s;
+    assert!(
+        (gb + v).abs() < 0.01 && gg.abs() < 0.01,
+        "ground {gb} / {gg}"
+    );
+    assert!(
+        (vb - v).abs() < 0.01 && (vg - v).abs() < 0.01,
+        "speed {vb} / {vg}"
+    );
 }

@@ -2,13 +2,17 @@
 //! run on generated KLAW walks recovers the commanded step length, step frequency and double
 //! support.
 //!
-//! - Default options (the primary source picked automatically: the Zeni coordinate method, 6 Hz
-//!   marker filter): mean step length and frequency within 1 %, every steady step's length within
-//!   1 %. The double support is *not* recovered this way: Zeni's toe off (the toe's most
-//!   posterior position relative to the pelvis) comes when the swing foot's forward speed has
-//!   caught up with the pelvis, 30–230 ms after the generated toe off (KLAW's swing foot starts
-//!   from rest under a decaying hip torque; the slower the walk, the later) — measured +63 % at
-//!   1.5 km/h, +31 % at 7 km/h; printed, not asserted.
+//! - Default options (the primary source picked automatically: for a walk from markers alone the
+//!   foot-speed detector — Zeni windows refined by the heel and toe speed over the ground,
+//!   Bonci et al. 2022 —, 6 Hz marker filter): mean step length and frequency within 1 %, every
+//!   steady step's length within 1 %, and the double support within 3 frames (or 10 %) of t_ds
+//!   at 5 and 7 km/h (measured +1.4 and +0.1 frames; the Zeni coordinate method gave +31 % at
+//!   7 km/h). At 1.5 and 3 km/h it is still long (+0.21 s, +0.06 s, measured): there the
+//!   generated swing foot stays within 5 mm of the floor and moves at less than a quarter of
+//!   the walking speed for 50–170 ms after its toe off (KLAW's swing starts from rest under a
+//!   decaying hip torque), so no speed criterion can see it leave; those two speeds are printed
+//!   and listed in `SWING_STARTS_FROM_REST`, to be asserted once the generator's swing starts
+//!   with the virtual leg's velocity.
 //! - Foot-marker heights (the data are noise free: 1 mm height tolerance, 45 Hz filter): the
 //!   double support comes back within 3 frames (30 ms) of t_ds at every speed. With the default
 //!   1 cm tolerance the toe, which rises tangentially and is held only 5 mm (the toe-clearance
@@ -18,11 +22,18 @@ use gaitfit::generator::walking::high_level::phase_times;
 use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
 use gaitfit::ingest::trials::StepRow;
 
+/// Speeds (km/h) whose generated toe off the default detector cannot see yet (module docs).
+const SWING_STARTS_FROM_REST: &[f64] = &[1.5, 3.0];
+
 #[test]
 fn detection_recovers_step_length_frequency_and_double_support() {
-    let zeni = EventOptions {
+    let default = EventOptions {
         gait: Some(Gait::Walk),
         ..EventOptions::default()
+    };
+    let zeni = EventOptions {
+        primary: PrimarySource::ZeniCoordinate,
+        ..default.clone()
     };
     let mut heights = EventOptions {
         primary: PrimarySource::FootHeight,
@@ -69,15 +80,17 @@ fn detection_recovers_step_length_frequency_and_double_support() {
             v
         };
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-        let rows = detect(&zeni);
+        let rows = detect(&default);
         let sls = values(&rows, &|r| r.step_length_m);
         let sf_m = mean(&values(&rows, &|r| r.step_freq_hz));
-        let ds_zeni = mean(&values(&rows, &|r| r.double_support_time_s));
+        let ds_default = mean(&values(&rows, &|r| r.double_support_time_s));
+        let ds_zeni = mean(&values(&detect(&zeni), &|r| r.double_support_time_s));
         let rows_h = detect(&heights);
         let ds_m = mean(&values(&rows_h, &|r| r.double_support_time_s));
         println!(
             "{kmh} km/h, h {h}: sl {:.4} (cmd {sl:.4}) m, sf {:.2} (cmd {:.2}) steps/min, \
-             t_ds {ds_m:.4} by foot heights, {ds_zeni:.4} by Zeni (cmd {t_ds:.4}) s",
+             t_ds {ds_default:.4} by default, {ds_m:.4} by foot heights, {ds_zeni:.4} by Zeni \
+             (cmd {t_ds:.4}) s",
             mean(&sls),
             sf_m * 60.0,
             sf * 60.0,
@@ -100,5 +113,12 @@ fn detection_recovers_step_length_frequency_and_double_support() {
             (ds_m - t_ds).abs() <= 3.0 / opts.fps,
             "{kmh} km/h: t_ds {ds_m} vs {t_ds}"
         );
+        let err = (ds_default - t_ds).abs();
+        if !SWING_STARTS_FROM_REST.contains(&kmh) {
+            assert!(
+                err <= 3.0 / opts.fps || err <= 0.1 * t_ds,
+                "{kmh} km/h: default t_ds {ds_default} vs {t_ds}"
+            );
+        }
     }
 }

@@ -3,7 +3,8 @@
 //!
 //! - [`filter`]: zero-phase Butterworth low-pass (forward–backward, scipy's edge handling);
 //! - [`force`]: vertical GRF threshold with hysteresis per foot, baseline offset and drift;
-//! - [`kinematic`]: Zeni et al. (2008) coordinate method and its velocity variant;
+//! - [`kinematic`]: Zeni et al. (2008) coordinate method and its velocity variant, and the
+//!   walking foot-speed detector seeded by it (Bonci et al. 2022);
 //! - [`phases`]: foot flat (FGM), heel off, meta off (MOM), toe off (TOM) from foot markers;
 //! - [`steps`]: one row per step in the trials schema, plus flight height (running paper eq. 3),
 //!   double support (walking paper §3) and the Ko–Badler μ inputs;
@@ -145,8 +146,9 @@ pub enum PrimarySource {
     /// events (C3D EVENT group; not a generator's own events); otherwise the force events if
     /// the plates saw at least two steps
     /// (successive heel strikes of opposite feet, no contact beside the plates in between:
-    /// an overground walkway); otherwise the Zeni coordinate method; otherwise the file's
-    /// events whatever their origin.
+    /// an overground walkway); otherwise, in walking, the foot-speed detector (Zeni windows
+    /// refined by the heel and toe speed over the ground, Bonci et al. 2022); otherwise the
+    /// Zeni coordinate method; otherwise the file's events whatever their origin.
     #[default]
     Auto,
     /// Force-plate events only.
@@ -157,12 +159,14 @@ pub enum PrimarySource {
     ZeniVelocity,
     /// Foot-marker heights seeded by the Zeni stances.
     FootHeight,
+    /// Heel and toe speed over the ground in the Zeni windows (walking; Bonci et al. 2022).
+    FootSpeed,
     /// The events stored in the file (C3D EVENT group).
     Reference,
 }
 
 impl PrimarySource {
-    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|foot-height|reference`.
+    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|foot-height|foot-speed|reference`.
     pub fn parse(s: &str) -> Option<Self> {
         match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
             "auto" => Some(Self::Auto),
@@ -170,6 +174,7 @@ impl PrimarySource {
             "zeni" | "zeni-coordinate" | "coordinate" | "kinematic" => Some(Self::ZeniCoordinate),
             "zeni-velocity" | "velocity" => Some(Self::ZeniVelocity),
             "foot" | "foot-height" => Some(Self::FootHeight),
+            "foot-speed" | "speed" | "bonci" => Some(Self::FootSpeed),
             "reference" | "c3d" => Some(Self::Reference),
             _ => None,
         }
@@ -229,6 +234,9 @@ pub struct TrialEvents {
     /// Initial contact and toe off from the foot-marker heights, seeded by the Zeni stances
     /// (see [`phases::foot_contact_events`]).
     pub foot_contact: Vec<GaitEvent>,
+    /// Heel strike and toe off from the heel and toe speed over the ground within the Zeni
+    /// windows (walking trials only; see [`kinematic::Kinematics::foot_speed`]).
+    pub foot_speed: Vec<GaitEvent>,
     /// Foot-marker phases of the primary stances (foot flat, heel off, meta off, and toe off
     /// from a distinct toe marker).
     pub phases: Vec<GaitEvent>,
@@ -248,6 +256,7 @@ impl TrialEvents {
             EventSource::ZeniCoordinate => &self.zeni_coordinate,
             EventSource::ZeniVelocity => &self.zeni_velocity,
             EventSource::FootMarkers => &self.foot_contact,
+            EventSource::FootSpeed => &self.foot_speed,
             EventSource::Reference => &self.reference,
             EventSource::Generated => &[],
         }
@@ -290,6 +299,14 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         }
         None => (Vec::new(), Vec::new(), Vec::new()),
     };
+    let walking = match opts.gait.or(trial.gait) {
+        Some(g) => g == Gait::Walk,
+        None => looks_like_walking(&zc),
+    };
+    let fs = match &kin {
+        Some(k) if walking => k.foot_speed(&zc, &opts.kinematic),
+        _ => Vec::new(),
+    };
     let mut ev = TrialEvents {
         path: path.clone(),
         trial: trial.name.clone(),
@@ -299,6 +316,7 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         zeni_coordinate: zc,
         zeni_velocity: zv,
         foot_contact: fc,
+        foot_speed: fs,
         phases: Vec::new(),
         reference: trial.reference_events.clone(),
         primary: EventSource::Force,
@@ -352,6 +370,26 @@ fn force_steps(ev: &[GaitEvent], kinematic: &[GaitEvent]) -> Option<usize> {
     Some(n)
 }
 
+/// Whether the Zeni events describe walking: at most heel strikes the other foot is still on
+/// the ground (its last event before is a heel strike: double support) rather than in the air
+/// (its last event is a toe off: flight). Used only when neither the options nor the trial
+/// say which gait it is.
+fn looks_like_walking(zeni: &[GaitEvent]) -> bool {
+    let (mut walk, mut run) = (0usize, 0usize);
+    for e in zeni.iter().filter(|e| e.kind == EventKind::HeelStrike) {
+        let other = zeni
+            .iter()
+            .filter(|o| o.side != e.side && o.time_s < e.time_s)
+            .max_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        match other.map(|o| o.kind) {
+            Some(EventKind::HeelStrike) => walk += 1,
+            Some(EventKind::ToeOff) => run += 1,
+            _ => {}
+        }
+    }
+    walk > run
+}
+
 /// Whether the file's events were measured (a laboratory's C3D events) rather than written by
 /// a generator: a generated motion's own events are its ground truth, and detecting events on
 /// it is the point of reading it back (closing the loop), so they do not replace detection.
@@ -386,6 +424,10 @@ fn choose_primary(
         }
         PrimarySource::ZeniVelocity => need(EventSource::ZeniVelocity, "the Zeni velocity method"),
         PrimarySource::FootHeight => need(EventSource::FootMarkers, "the foot-marker heights"),
+        PrimarySource::FootSpeed => need(
+            EventSource::FootSpeed,
+            "the foot-speed detector (walking only: pass --gait walk if the trial is a walk)",
+        ),
         PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
         PrimarySource::Auto => {
             // The file's own events come before the Zeni estimate: on the shared overground
@@ -403,6 +445,10 @@ fn choose_primary(
                 // Overground plates that saw at least two successive steps (BMClab's walkway):
                 // fewer steps than the markers give, but timed by the plates.
                 Ok(EventSource::Force)
+            } else if has_both_kinds(&ev.foot_speed) {
+                // Walking from markers alone: the Zeni windows refined by the foot's own speed
+                // over the ground, which removes the Zeni heel-strike bias (reports/events.md).
+                Ok(EventSource::FootSpeed)
             } else if has_both_kinds(&ev.zeni_coordinate) {
                 Ok(EventSource::ZeniCoordinate)
             } else if has_both_kinds(&ev.reference) {
@@ -428,7 +474,7 @@ pub fn steps_from_trial(trial: &Trial, opts: &EventOptions) -> Result<StepTable,
 }
 
 impl Analysis {
-    /// Compares the kinematic methods (Zeni coordinate and velocity, foot heights) with the
+    /// Compares the kinematic methods (Zeni coordinate and velocity, foot heights, foot speed) with the
     /// force-plate events (`reference = Force`; then also the file's own events, as
     /// `file_events`) or with the file's reference events (`Reference`), over the time both
     /// cover. Returns an empty table when either side has no events.
@@ -473,6 +519,7 @@ impl Analysis {
             ("zeni_coordinate", &self.events.zeni_coordinate),
             ("zeni_velocity", &self.events.zeni_velocity),
             ("foot_height", &self.events.foot_contact),
+            ("foot_speed", &self.events.foot_speed),
         ] {
             let res = compare::compare(det, refs, coverage, span, tol_s);
             table.add(name, rname, &res);

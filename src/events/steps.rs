@@ -174,6 +174,7 @@ pub fn steps_from_analysis(
         EventSource::ZeniVelocity => "zeni_velocity",
         EventSource::Reference => "reference",
         EventSource::FootMarkers => "foot_height",
+        EventSource::FootSpeed => "foot_speed",
         EventSource::Generated => "generated",
     };
     let setting = opts.setting.unwrap_or(match (trial.setting, kin) {

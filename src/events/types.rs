@@ -125,6 +125,8 @@ pub enum EventSource {
     ZeniVelocity,
     /// Foot-marker kinematics (heel/metatarsal/toe heights and velocities) for the finer phases.
     FootMarkers,
+    /// Heel and toe speed over the ground within the Zeni windows (walking; Bonci et al. 2022).
+    FootSpeed,
     /// Read from the input file (e.g. a C3D EVENT group); kept for comparison, never overwritten.
     Reference,
     /// Produced by one of gaitfit's generators.
