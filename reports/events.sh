@@ -38,28 +38,52 @@ events build them) is in the `data/*.csv` tables.
 
 - **Walking, kinematic vs force.** The Zeni et al. (2008) coordinate method misses the aim
   (|mean| ≤ 10 ms, SD ≤ 15 ms) at heel strike on both overground data sets with plates: about
-  −34 ± 8 ms (Schreiber) and −36 ± 12 ms (BMClab walk), i.e. early. Toe off meets it on
-  Schreiber (−1 ± 6 ms) but not on BMClab (+21 ± 7 ms; no toe-tip marker there, the
-  metatarsal heads stand in). The velocity variant is no better at heel strike and worse at toe
-  off. WBDS has no markers in the shared data (force only), so no comparison there.
-- **Cause of the heel-strike bias** (checked, not assumed): not filter lag — the error moves
-  by less than 3 ms for marker cut-offs of 6 to 45 Hz (the filter is zero-phase); not a
+  −34 ± 8 ms (Schreiber) and −36 ± 12 ms (BMClab walk), i.e. early. The foot-speed detector
+  (`foot_speed`, the default for walks from markers alone) meets it at heel strike on both:
+  −8 ± 12 ms (Schreiber) and −7 ± 10 ms (BMClab). Its toe off meets it on BMClab (+5 ± 7 ms)
+  and misses the mean on Schreiber (−16 ± 6 ms), where Zeni's toe off is −1 ± 6 ms; on BMClab
+  Zeni's is +21 ± 7 ms. Every toe-marker criterion tried (Zeni; toe forward or 3-D speed above
+  0.3–1.0 × the walking speed; O'Connor's foot-centre vertical-velocity peak; toe height above
+  its stance level) is 17–22 ms earlier against the plates on Schreiber than on BMClab, so no
+  published toe-off rule meets the aim on both without a threshold tuned to these data; none
+  was tuned. WBDS has no markers in the shared data (force only), so no comparison there.
+- **Cause of the Zeni heel-strike bias** (checked, not assumed): not filter lag — the error
+  moves by less than 3 ms for marker cut-offs of 6 to 45 Hz (the filter is zero-phase); not a
   marker mix-up — the heel role is the calcaneus marker the method prescribes (Schreiber
-  `L_FCC`/`R_FCC`). It is the definition: the heel leads the
-  pelvis most when its ground-frame speed equals the pelvis speed, and it still decelerates for
-  30–40 ms before it loads the plate (visible in the check plots). Alternatives tried on these
-  data, none within the aim without a threshold tuned on the same data: heel height reaching
+  `L_FCC`/`R_FCC`). It is the definition: the heel leads the pelvis most when its ground-frame
+  speed equals the pelvis speed, and it still decelerates for 30–40 ms before it loads the
+  plate (visible in the check plots). Alternatives tried on these data: heel height reaching
   its stance level (−100 ms: the calcaneus marker skims the floor through terminal swing),
-  heel sagittal speed below 50 mm/s (Ghoussayni et al. 2004: +54 to +83 ms), peak heel vertical
-  acceleration (Hreljac & Marshall 2000, at 100–150 Hz after filtering: −75 to −145 ms). No
-  per-method offset is applied.
+  heel sagittal speed below 50 mm/s (Ghoussayni et al. 2004: +54 to +83 ms), peak heel
+  vertical acceleration (Hreljac & Marshall 2000, at 100–150 Hz after filtering: −75 to
+  −145 ms), minimum of the heel–toe midpoint's vertical velocity (O'Connor et al. 2007: +23 and
+  +11 ms, SD 12–14 ms). What works is a threshold on the heel's speed over the ground *relative
+  to the walking speed* inside the Zeni window (Bonci et al. 2022: 3-D heel speed below 0.5 ×
+  the walking speed; on a treadmill the belt velocity, measured from the toe marker in
+  mid-stance, is removed first): it marks the end of the heel's deceleration, not its largest
+  lead on the pelvis. No per-method offset is applied.
+- **Foot-speed vs Zeni against the plates, per data set** (detected − force, mean ± SD; the
+  event rows are those of the `--compare force` tables below; double support from
+  `cargo test --release --test events_foot_speed -- --ignored --nocapture`, over the double
+  supports the plates saw whole, in % of the gait cycle):
+
+  | data set | method | heel strike ms | toe off ms | double support % cycle |
+  |---|---|---|---|---|
+  | Schreiber | foot speed | −8.3 ± 11.5 (12) | −15.8 ± 6.0 (24) | −0.9 ± 1.6 (12) |
+  | Schreiber | Zeni coordinate | −34.1 ± 8.1 (11) | −1.0 ± 6.2 (24) | +3.1 ± 1.1 (11) |
+  | BMClab walks | foot speed | −7.4 ± 10.4 (7) | +5.2 ± 6.8 (5) | +1.4 ± 0.8 (5) |
+  | BMClab walks | Zeni coordinate | −36.1 ± 12.1 (7) | +20.8 ± 7.2 (5) | +5.6 ± 0.9 (5) |
+
+- **Winter's walk** (no force data in the file; the data README gives his events, right heel
+  strikes at frames 28 and 97, toe off at 70): the foot-speed detector finds frames 27.3, 96.3
+  and 69.3; Zeni 25.1, 94.2 and 70.2 (stance 0.602 s against his 0.601 s; Zeni 0.646 s).
 - **What the steps are built from, therefore**: per-foot plates (WBDS, Hamner, BMClab run) →
   force events; Schreiber → the C3D's own events (against the plates −3 ± 7 ms at heel strike,
   +14 ± 9 ms at toe off, `file_events` below); BMClab walk → the force plates, which saw three
-  successive steps in each walk. Zeni events build steps only when nothing better exists.
-  Before this, Schreiber's and BMClab's double support came from Zeni events and was
-  inflated by the heel-strike bias (BMClab walk 15.3 % → 9.5–10.6 % of the cycle; Schreiber's
-  steps are now one more per trial, from the file's events).
+  successive steps in each walk; Winter → the foot-speed detector. Zeni events build steps only
+  for running trials with markers alone. Before this, Schreiber's and BMClab's double support
+  came from Zeni events and was inflated by the heel-strike bias (BMClab walk 15.3 % →
+  9.5–10.6 % of the cycle).
 - **Double support, WBDS vs Schreiber.** WBDS subject 04 (treadmill, force events) 9.5, 8.9,
   8.4, 8.4 % of the cycle at 1.30–1.88 m/s; Schreiber self-selected (C4) 11.7–14.5 %, fast
   (C5) 8.3–13.0 %. Both are in the range reported for healthy adults (each double-support

@@ -4,24 +4,95 @@
 //! Aim (issue 4): |mean| ≤ 10 ms and SD ≤ 15 ms, detected − force, for heel strike and toe off
 //! in walking. Measured (`gaitfit events <set> --compare force`): Schreiber heel strike
 //! −8.3 ± 11.5 ms, toe off −15.8 ± 6.0 ms; BMClab walks heel strike −7.4 ± 10.4 ms, toe off
-//! +5.2 ± 6.8 ms. The Schreiber toe off misses the mean by 6 ms: every toe-marker method tried
+//! +5.2 ± 6.8 ms; double support −0.9 ± 1.6 and +1.4 ± 0.8 % of the cycle (Zeni +3.1 ± 1.1
+//! and +5.6 ± 0.9). The Schreiber toe off misses the mean by 6 ms: every toe-marker method tried
 //! is 17–22 ms earlier on Schreiber than on BMClab against the plates (Zeni −1 vs +21 ms), so
 //! no published threshold meets both; that shortfall is asserted as measured, not hidden.
 use gaitfit::events::compare::{CompareTable, KindCounts, DEFAULT_TOLERANCE_S};
 use gaitfit::events::input::{expand_inputs, read_input};
-use gaitfit::events::{analyse, EventKind, EventOptions, EventSource, Side};
+use gaitfit::events::{analyse, Analysis, EventKind, EventOptions, EventSource, GaitEvent, Side};
 use gaitfit::ingest::ReadOptions;
 use gaitfit::shared_data::require;
 
-fn compare_force(inputs: &[&str]) -> CompareTable {
+/// The comparison with the plates, and the mean double-support error (% of the cycle) of the
+/// foot-speed and Zeni events.
+fn compare_force(inputs: &[&str]) -> (CompareTable, f64, f64) {
     let paths: Vec<_> = inputs.iter().map(require).collect();
     let mut all = CompareTable::default();
+    let (mut ds_fs, mut ds_z) = (Vec::new(), Vec::new());
     for i in expand_inputs(&paths).unwrap() {
         let t = read_input(&i, &ReadOptions::default()).unwrap();
         let an = analyse(&t, &EventOptions::default()).unwrap();
         all.merge(&an.compare(EventSource::Force, DEFAULT_TOLERANCE_S));
+        ds_fs.extend(double_support_errors(&an, &an.events.foot_speed));
+        ds_z.extend(double_support_errors(&an, &an.events.zeni_coordinate));
     }
-    all
+    for (name, ds) in [("foot speed", &ds_fs), ("zeni", &ds_z)] {
+        let ms: Vec<f64> = ds.iter().map(|d| d.0).collect();
+        let pct: Vec<f64> = ds.iter().map(|d| d.1).collect();
+        let (m, sd) = mean_sd(&ms);
+        let (mp, sdp) = mean_sd(&pct);
+        eprintln!(
+            "{inputs:?} {name}: double support {m:.1} ± {sd:.1} ms = {mp:.2} ± {sdp:.2} % of \
+             the cycle (n {})",
+            ds.len()
+        );
+    }
+    let mean_pct = |ds: &[(f64, f64)]| mean_sd(&ds.iter().map(|d| d.1).collect::<Vec<_>>()).0;
+    (all, mean_pct(&ds_fs), mean_pct(&ds_z))
+}
+
+/// Double-support errors, detected − force, as `(ms, % of the gait cycle)`, one per double
+/// support the plates saw whole (a heel strike and the other foot's toe off within 0.3 s), for
+/// the events of `det` matched to both within the comparison tolerance. The cycle is the
+/// median interval between successive heel strikes of one foot in `det`.
+fn double_support_errors(an: &Analysis, det: &[GaitEvent]) -> Vec<(f64, f64)> {
+    let f = &an.events.force;
+    let near = |side: Side, kind: EventKind, t: f64| {
+        det.iter()
+            .filter(|e| e.side == side && e.kind == kind)
+            .map(|e| e.time_s)
+            .find(|d| (d - t).abs() < DEFAULT_TOLERANCE_S)
+    };
+    let mut cycles: Vec<f64> = Vec::new();
+    for side in [Side::Left, Side::Right] {
+        let hs: Vec<f64> = det
+            .iter()
+            .filter(|e| e.side == side && e.kind == EventKind::HeelStrike)
+            .map(|e| e.time_s)
+            .collect();
+        cycles.extend(hs.windows(2).map(|w| w[1] - w[0]));
+    }
+    cycles.sort_by(f64::total_cmp);
+    let Some(&cycle) = cycles.get(cycles.len() / 2) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for h in f.iter().filter(|e| e.kind == EventKind::HeelStrike) {
+        let Some(to) = f.iter().find(|e| {
+            e.kind == EventKind::ToeOff
+                && e.side != h.side
+                && e.time_s > h.time_s
+                && e.time_s < h.time_s + 0.3
+        }) else {
+            continue;
+        };
+        if let (Some(dh), Some(dt)) = (
+            near(h.side, EventKind::HeelStrike, h.time_s),
+            near(to.side, EventKind::ToeOff, to.time_s),
+        ) {
+            let err = (dt - dh) - (to.time_s - h.time_s);
+            out.push((err * 1000.0, 100.0 * err / cycle));
+        }
+    }
+    out
+}
+
+fn mean_sd(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, var.sqrt())
 }
 
 fn row<'a>(t: &'a CompareTable, method: &str, kind: EventKind) -> &'a KindCounts {
@@ -42,8 +113,16 @@ fn check(name: &str, c: &KindCounts, mean_range: (f64, f64), sd_max: f64, min_n:
 #[test]
 #[ignore = "needs ../shared/data"]
 fn foot_speed_meets_the_heel_strike_aim_on_both_overground_sets() {
-    let s = compare_force(&["schreiber2019"]);
-    let b = compare_force(&["bmclab/walk1.trc", "bmclab/walk2.trc"]);
+    let (s, s_ds, s_ds_zeni) = compare_force(&["schreiber2019"]);
+    let (b, b_ds, b_ds_zeni) = compare_force(&["bmclab/walk1.trc", "bmclab/walk2.trc"]);
+    // Double support against the plates, % of the cycle (measured −0.9 and +1.4 points; Zeni
+    // +3.1 and +5.6): within 1.5 points, and at most half of Zeni's error.
+    for (name, fs, z) in [("Schreiber", s_ds, s_ds_zeni), ("BMClab", b_ds, b_ds_zeni)] {
+        assert!(
+            fs.abs() <= 1.5 && fs.abs() <= 0.5 * z.abs(),
+            "{name}: double support error {fs:.2} % (Zeni {z:.2} %)"
+        );
+    }
     let hs = EventKind::HeelStrike;
     let to = EventKind::ToeOff;
     check(
