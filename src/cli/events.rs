@@ -42,7 +42,9 @@ pub struct Args {
     #[arg(short, long)]
     pub verbose: bool,
     /// Which events build the steps: auto (force with per-foot plates, else the file's own
-    /// events, else Zeni), force, zeni, zeni-velocity, reference.
+    /// events, else the plates if they saw two steps, else foot-speed for walks and Zeni for
+    /// runs), force, zeni, zeni-velocity, foot-height, foot-speed (walks: Zeni windows refined
+    /// by the heel and toe speed over the ground, Bonci et al. 2022), reference.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
     pub events: String,
     /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
@@ -89,7 +91,8 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     read.belt_speed_m_per_s = args.belt_speed;
     opts.primary = PrimarySource::parse(&args.events).with_context(|| {
         format!(
-            "--events {}: use auto, force, zeni, zeni-velocity or reference",
+            "--events {}: use auto, force, zeni, zeni-velocity, foot-height, foot-speed or \
+             reference",
             args.events
         )
     })?;
