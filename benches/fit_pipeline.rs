@@ -1,7 +1,8 @@
 //! End-to-end fit of the four relations on a generated 1,000,000-row trials CSV: parse,
 //! validate, fit, statistics (no bootstrap, no plots). Fixed seed.
 //!
-//! `cargo bench --bench fit_pipeline`. Set `GAITFIT_BENCH_ROWS` to change the size.
+//! `cargo bench --bench fit_pipeline`. Set `GAITFIT_BENCH_ROWS` to change the size, and
+//! `GAITFIT_BENCH_CSV` to keep the generated table at that path.
 //!
 //! Before the criterion groups, one pass of every stage is timed and printed twice: wall clock
 //! and the CPU time of the benchmarking thread (`/proc/thread-self/schedstat`, Linux). The
@@ -98,7 +99,10 @@ fn bench(c: &mut Criterion) {
         .and_then(|s| s.parse().ok())
         .unwrap_or(1_000_000);
     let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("trials.csv");
+    // GAITFIT_BENCH_CSV=<path> keeps the generated table there (to diff fits across versions).
+    let path = std::env::var_os("GAITFIT_BENCH_CSV")
+        .map(std::path::PathBuf::from)
+        .unwrap_or_else(|| dir.path().join("trials.csv"));
     write_csv(&path, rows);
     let rels = rels();
     let opts = FitOptions::default();

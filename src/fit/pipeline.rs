@@ -575,9 +575,12 @@ pub fn fit_relation(
     let published = rel.values().to_vec();
     // Rows sorted once by the breakpoint key, with prefix sums: every profile evaluation
     // below (search, F-test, intervals, folds, bootstrap) then costs O(p³), not a pass.
+    // The tree over all rows serves fits without per-subject columns; with them, every
+    // evaluation (and fold, and replicate) sums subjects' trees.
+    let with_all = !(rel.subject_effect().is_some() && prep.subjects.len() >= 2);
     let sorted = rel
         .sorted_profile()
-        .map(|form| SortedRows::new(form, &prep));
+        .map(|form| SortedRows::new(form, &prep, with_all));
     let all_keys: Vec<f64> = sorted.as_ref().map_or_else(Vec::new, |sr| {
         sr.distinct_keys(&vec![true; prep.subjects.len()])
     });
@@ -594,7 +597,7 @@ pub fn fit_relation(
         },
     };
     let plan = match &sorted {
-        Some(sr) => sr.form.plan_sorted(&all_keys),
+        Some(sr) => sr.form().plan_sorted(&all_keys),
         None => rel.plan(&prep.obs),
     };
     let mut free: Vec<bool> = plan.held.iter().map(|h| h.is_none()).collect();

@@ -5,12 +5,14 @@
 //! # Sorted prefix sums
 //! Relations with a [`SortedProfile`] give the normal equations at any trial value from sums
 //! of per-row features over ranges of one key (their breakpoints split the rows by it): the
-//! rows are sorted by key **once** (O(n log n)), each subject's weighted features are
-//! prefix-summed (Neumaier-compensated, so a range sum is exact to rounding of the prefix), and
-//! every evaluation costs one binary search per subject and query plus an O(p³) solve. A
-//! subject multiset (a leave-one-subject-out fold, a bootstrap replicate) is a weighted sum of
-//! per-subject prefixes, so folds never touch the rows either. Relations without one fall back
-//! to a pass over the rows per evaluation (exact, slow on large tables).
+//! rows are sorted by key **once** (a radix sort, O(n)) and gathered into key order, and binary
+//! trees of weighted feature sums are built over all rows and over each subject's rows (all
+//! leaves in one sequential pass; the tree over all rows only when a fit without per-subject
+//! columns asks for it). Every evaluation then costs a binary search per tree and range plus
+//! O(log n) node sums and an O(p³) solve. A subject multiset (a leave-one-subject-out fold, a
+//! bootstrap replicate) is a weighted sum of per-subject trees, so folds never touch the rows
+//! either. Relations without one fall back to a pass over the rows per evaluation (exact, slow
+//! on large tables).
 //!
 //! # Searches
 //! - A breakpoint whose residual sum of squares varies continuously (a plateau onset, a knot
@@ -36,6 +38,7 @@ use crate::relations::{
 use nalgebra::DVector;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
+use std::sync::OnceLock;
 
 /// Evaluations after which the exact search of a discrete breakpoint stops and keeps the best
 /// partition found (with a note): reached only by a profile that is flat over a great many
@@ -54,55 +57,97 @@ const LEAF: usize = 8;
 /// 2·[`LEAF`] rows.
 struct Tree {
     keys: Vec<f64>,
-    /// Index of each row in [`SortedRows`]'s key-ordered observations (ascending).
+    /// Index of each row in the prepared rows, in key order.
     rows: Vec<u32>,
     /// Leaves, a power of two.
     size: usize,
+    /// The node sums. Those of the subjects' trees are built with the index; the tree over all
+    /// rows is built on first use (fits with a per-subject column never query it).
+    nodes: OnceLock<Nodes>,
+}
+
+/// The nodes of a [`Tree`].
+struct Nodes {
     /// Per node: lowest and highest key (`+∞, −∞` when empty).
     span: Vec<(f64, f64)>,
     /// Per node: `k` sums about the node's centre.
     sums: Vec<f64>,
 }
 
-impl Tree {
-    fn new(
-        form: &dyn SortedProfile,
-        scale: &KeyScale,
-        k: usize,
-        data: &Sorted,
-        keys: Vec<f64>,
-        rows: Vec<u32>,
-    ) -> Tree {
-        let n = rows.len();
-        let leaves = n.div_ceil(LEAF).max(1);
-        let size = leaves.next_power_of_two();
-        let mut span = vec![(f64::INFINITY, f64::NEG_INFINITY); 2 * size];
-        let mut sums = vec![0.0; 2 * size * k];
+/// What the trees' sums are made of: the relation's sorted form, the key scale, the number of
+/// features and the rows in key order (trees index them through [`Tree::rows`]).
+struct Ctx<'a> {
+    form: &'a dyn SortedProfile,
+    scale: KeyScale,
+    k: usize,
+    data: Vec<Row>,
+}
+
+/// A prepared row with its weight.
+#[derive(Clone, Copy)]
+struct Row {
+    obs: Observation,
+    weight: f64,
+}
+
+impl Ctx<'_> {
+    /// Adds `mult` × row `i`'s weighted features about `centre` to `out`.
+    #[inline]
+    fn add_row(&self, i: usize, centre: f64, mult: f64, out: &mut [f64]) {
         let mut f = [0.0; MAX_PROFILE_FEATURES];
-        for l in 0..leaves {
-            let (a, b) = (l * LEAF, ((l + 1) * LEAF).min(n));
-            if a >= b {
-                continue;
-            }
-            let node = size + l;
-            span[node] = (keys[a], keys[b - 1]);
-            let c = 0.5 * (keys[a] + keys[b - 1]);
-            let out = &mut sums[node * k..(node + 1) * k];
-            for &i in &rows[a..b] {
-                let i = i as usize;
-                form.features(scale, c, &data.obs[i], &mut f[..k]);
-                let w = data.weights[i];
-                out.iter_mut().zip(&f).for_each(|(s, f)| *s += w * f);
-            }
+        self.form
+            .features(&self.scale, centre, &self.data[i].obs, &mut f[..self.k]);
+        let m = mult * self.data[i].weight;
+        out.iter_mut()
+            .zip(&f[..self.k])
+            .for_each(|(s, f)| *s += m * f);
+    }
+}
+
+impl Tree {
+    /// A tree over rows `rows` (key order) with keys `keys`, its nodes not built yet.
+    fn index(keys: Vec<f64>, rows: Vec<u32>) -> Tree {
+        let leaves = keys.len().div_ceil(LEAF).max(1);
+        Tree {
+            keys,
+            rows,
+            size: leaves.next_power_of_two(),
+            nodes: OnceLock::new(),
         }
-        for i in (1..size).rev() {
+    }
+
+    /// Nodes with zero sums and the leaves' key spans set.
+    fn empty_nodes(&self, k: usize) -> Nodes {
+        let n = self.keys.len();
+        let mut span = vec![(f64::INFINITY, f64::NEG_INFINITY); 2 * self.size];
+        for l in 0..n.div_ceil(LEAF) {
+            let (a, b) = (l * LEAF, ((l + 1) * LEAF).min(n));
+            span[self.size + l] = (self.keys[a], self.keys[b - 1]);
+        }
+        Nodes {
+            span,
+            sums: vec![0.0; 2 * self.size * k],
+        }
+    }
+
+    /// The centre of a node's keys.
+    #[inline]
+    fn centre(span: (f64, f64)) -> f64 {
+        0.5 * (span.0 + span.1)
+    }
+
+    /// Sums the inner nodes from the leaves.
+    fn finish(&self, ctx: &Ctx, nodes: &mut Nodes) {
+        let k = ctx.k;
+        let Nodes { span, sums } = nodes;
+        for i in (1..self.size).rev() {
             let (l, r) = (span[2 * i], span[2 * i + 1]);
             let sp = (l.0.min(r.0), l.1.max(r.1));
             span[i] = sp;
             if sp.0 > sp.1 {
                 continue;
             }
-            let c = 0.5 * (sp.0 + sp.1);
+            let c = Tree::centre(sp);
             let mut acc = [0.0; MAX_PROFILE_FEATURES];
             for child in [2 * i, 2 * i + 1] {
                 let (lo, hi) = span[child];
@@ -111,18 +156,35 @@ impl Tree {
                 }
                 let mut t = [0.0; MAX_PROFILE_FEATURES];
                 t[..k].copy_from_slice(&sums[child * k..(child + 1) * k]);
-                form.shift(scale, &mut t, 0.5 * (lo + hi), c);
+                ctx.form
+                    .shift(&ctx.scale, &mut t, Tree::centre((lo, hi)), c);
                 acc.iter_mut().zip(&t).for_each(|(a, t)| *a += t);
             }
             sums[i * k..(i + 1) * k].copy_from_slice(&acc[..k]);
         }
-        Tree {
-            keys,
-            rows,
-            size,
-            span,
-            sums,
+    }
+
+    /// Builds the nodes with one pass over the tree's rows.
+    fn build(&self, ctx: &Ctx) -> Nodes {
+        let k = ctx.k;
+        let mut nodes = self.empty_nodes(k);
+        for (j, &i) in self.rows.iter().enumerate() {
+            let node = self.size + j / LEAF;
+            let c = Tree::centre(nodes.span[node]);
+            ctx.add_row(
+                i as usize,
+                c,
+                1.0,
+                &mut nodes.sums[node * k..(node + 1) * k],
+            );
         }
+        self.finish(ctx, &mut nodes);
+        nodes
+    }
+
+    /// The nodes, built on first use.
+    fn nodes(&self, ctx: &Ctx) -> &Nodes {
+        self.nodes.get_or_init(|| self.build(ctx))
     }
 
     /// First row whose key is `≥ t` (`> t` unless `inclusive`).
@@ -145,13 +207,9 @@ impl Tree {
     }
 
     /// Adds `mult` × the sums of rows `a..b` about `centre` to `out`.
-    #[allow(clippy::too_many_arguments)]
     fn add_span(
         &self,
-        form: &dyn SortedProfile,
-        scale: &KeyScale,
-        k: usize,
-        data: &Sorted,
+        ctx: &Ctx,
         a: usize,
         b: usize,
         centre: f64,
@@ -161,13 +219,10 @@ impl Tree {
         if a >= b {
             return;
         }
-        let mut f = [0.0; MAX_PROFILE_FEATURES];
-        let mut rows = |a: usize, b: usize, out: &mut FeatureSums| {
+        let k = ctx.k;
+        let rows = |a: usize, b: usize, out: &mut FeatureSums| {
             for &i in &self.rows[a..b] {
-                let i = i as usize;
-                form.features(scale, centre, &data.obs[i], &mut f[..k]);
-                let m = mult * data.weights[i];
-                out.iter_mut().zip(&f[..k]).for_each(|(s, f)| *s += m * f);
+                ctx.add_row(i as usize, centre, mult, &mut out[..]);
             }
         };
         let (fa, fb) = (a.div_ceil(LEAF), b / LEAF);
@@ -177,14 +232,16 @@ impl Tree {
         }
         rows(a, fa * LEAF, out);
         rows(fb * LEAF, b, out);
+        let nodes = self.nodes(ctx);
         let node = |i: usize, out: &mut FeatureSums| {
-            let (lo, hi) = self.span[i];
+            let (lo, hi) = nodes.span[i];
             if lo > hi {
                 return;
             }
             let mut t = [0.0; MAX_PROFILE_FEATURES];
-            t[..k].copy_from_slice(&self.sums[i * k..(i + 1) * k]);
-            form.shift(scale, &mut t, 0.5 * (lo + hi), centre);
+            t[..k].copy_from_slice(&nodes.sums[i * k..(i + 1) * k]);
+            ctx.form
+                .shift(&ctx.scale, &mut t, Tree::centre((lo, hi)), centre);
             out.iter_mut()
                 .zip(&t[..k])
                 .for_each(|(s, t)| *s += mult * t);
@@ -208,24 +265,13 @@ impl Tree {
 /// The rows of a fit sorted by the relation's breakpoint key: one tree over all rows and one per
 /// subject (folds subtract a subject from the whole; bootstrap replicates add subjects).
 pub(super) struct SortedRows<'a> {
-    /// The relation's sorted form.
-    pub form: &'a dyn SortedProfile,
-    /// Scale of the key (features are powers of (key − c)/half_width).
-    pub scale: KeyScale,
-    /// The rows in key order.
-    data: Sorted,
-    k: usize,
+    /// The relation's sorted form, the key scale (features are powers of
+    /// (key − c)/half_width) and the prepared rows.
+    ctx: Ctx<'a>,
     all: Tree,
     /// Subject of each row of `all`, in key order.
     key_subject: Vec<u32>,
     subj: Vec<Tree>,
-}
-
-/// Observations and weights in key order: one gather from the prepared rows, after which every
-/// tree reads them sequentially (a gather per tree cost more than the trees).
-struct Sorted {
-    obs: Vec<Observation>,
-    weights: Vec<f64>,
 }
 
 /// A key mapped to an integer of the same order as `f64::total_cmp` (for a fast sort).
@@ -245,11 +291,60 @@ fn from_ordered_bits(b: u64) -> f64 {
     f64::from_bits(if b >> 63 == 1 { b & !(1 << 63) } else { !b })
 }
 
+/// Sorts `v` ascending. Below a few thousand items by comparison; above, by a stable
+/// least-significant-digit radix sort on the high 64 bits (11-bit digits; digits that all items
+/// share are skipped), which gives the same order when the low 64 bits ascend with the position
+/// (`SortedRows::new`: the row index, unique): ties in the high bits keep that order.
+fn sort_by_high_bits(v: &mut Vec<u128>) {
+    const BITS: usize = 11;
+    const PASSES: usize = 64_usize.div_ceil(BITS);
+    const RADIX: usize = 1 << BITS;
+    let n = v.len();
+    if n < 4096 {
+        v.sort_unstable();
+        return;
+    }
+    let digit = |x: u128, p: usize| (((x >> 64) as u64 >> (p * BITS)) as usize) & (RADIX - 1);
+    let mut hist = vec![[0usize; RADIX]; PASSES];
+    for &x in v.iter() {
+        for (p, h) in hist.iter_mut().enumerate() {
+            h[digit(x, p)] += 1;
+        }
+    }
+    let mut buf = vec![0u128; n];
+    let mut in_buf = false;
+    for (p, h) in hist.iter().enumerate() {
+        if h.contains(&n) {
+            continue;
+        }
+        let mut off = [0usize; RADIX];
+        let mut acc = 0;
+        for (o, &c) in off.iter_mut().zip(h) {
+            *o = acc;
+            acc += c;
+        }
+        let (src, dst) = if in_buf {
+            (&buf[..], &mut v[..])
+        } else {
+            (&v[..], &mut buf[..])
+        };
+        for &x in src {
+            let d = digit(x, p);
+            dst[off[d]] = x;
+            off[d] += 1;
+        }
+        in_buf = !in_buf;
+    }
+    if in_buf {
+        std::mem::swap(v, &mut buf);
+    }
+}
+
 impl<'a> SortedRows<'a> {
-    /// Sorts the prepared rows by key and builds the trees.
-    pub fn new(form: &'a dyn SortedProfile, prep: &Prepared) -> SortedRows<'a> {
-        // Ties by row index: the order (and so every rounding) is deterministic. Sorting
-        // (key bits, index) pairs as one integer is several times faster than comparing f64s.
+    /// Sorts the prepared rows by key and builds the subjects' trees, and the tree over all
+    /// rows when `with_all` (otherwise on first use).
+    pub fn new(form: &'a dyn SortedProfile, prep: &Prepared, with_all: bool) -> SortedRows<'a> {
+        // Ties by row index: the order (and so every rounding) is deterministic.
         let mut order: Vec<u128> = prep
             .obs
             .iter()
@@ -260,7 +355,7 @@ impl<'a> SortedRows<'a> {
                 ((ordered_bits(form.key(&o.x)) as u128) << 64) | ((i as u128) << 32) | s as u128
             })
             .collect();
-        order.sort_unstable();
+        sort_by_high_bits(&mut order);
         let n = order.len();
         let key_of = |v: u128| from_ordered_bits((v >> 64) as u64);
         let scale = match (order.first(), order.last()) {
@@ -276,46 +371,90 @@ impl<'a> SortedRows<'a> {
         let mut per_keys: Vec<Vec<f64>> = count.iter().map(|&c| Vec::with_capacity(c)).collect();
         let mut per_rows: Vec<Vec<u32>> = count.iter().map(|&c| Vec::with_capacity(c)).collect();
         let mut keys = Vec::with_capacity(n);
+        let mut rows = Vec::with_capacity(n);
         let mut key_subject = Vec::with_capacity(n);
-        let mut data = Sorted {
-            obs: Vec::with_capacity(n),
-            weights: Vec::with_capacity(n),
-        };
+        // One gather of the rows into key order (a tight loop: many reads in flight), after
+        // which every tree reads them sequentially.
+        let data: Vec<Row> = order
+            .iter()
+            .map(|&v| {
+                let i = ((v >> 32) as u32) as usize;
+                Row {
+                    obs: prep.obs[i],
+                    weight: prep.weights[i],
+                }
+            })
+            .collect();
         for (j, &v) in order.iter().enumerate() {
-            let i = ((v >> 32) as u32) as usize;
             let key = key_of(v);
             let s = (v as u32) as usize;
             per_keys[s].push(key);
             per_rows[s].push(j as u32);
             keys.push(key);
+            rows.push(j as u32);
             key_subject.push(s as u32);
-            data.obs.push(prep.obs[i]);
-            data.weights.push(prep.weights[i]);
         }
         drop(order);
-        let all = Tree::new(form, &scale, k, &data, keys, (0..n as u32).collect());
-        let subj = per_keys
-            .into_iter()
-            .zip(per_rows)
-            .map(|(kk, rr)| Tree::new(form, &scale, k, &data, kk, rr))
-            .collect();
-        SortedRows {
+        let ctx = Ctx {
             form,
             scale,
-            data,
             k,
+            data,
+        };
+        let all = Tree::index(keys, rows);
+        let subj: Vec<Tree> = per_keys
+            .into_iter()
+            .zip(per_rows)
+            .map(|(kk, rr)| Tree::index(kk, rr))
+            .collect();
+        // The leaves of every tree in one pass in key order: each row is read once (a random
+        // read of the prepared rows) for its leaf in the tree over all rows and in its subject's.
+        let mut all_nodes = with_all.then(|| all.empty_nodes(k));
+        let mut subj_nodes: Vec<Nodes> = subj.iter().map(|t| t.empty_nodes(k)).collect();
+        let mut pos = vec![0usize; ns];
+        for (j, (&i, &s)) in all.rows.iter().zip(&key_subject).enumerate() {
+            let (i, s) = (i as usize, s as usize);
+            if let Some(nd) = &mut all_nodes {
+                let node = all.size + j / LEAF;
+                let c = Tree::centre(nd.span[node]);
+                ctx.add_row(i, c, 1.0, &mut nd.sums[node * k..(node + 1) * k]);
+            }
+            let nd = &mut subj_nodes[s];
+            let node = subj[s].size + pos[s] / LEAF;
+            pos[s] += 1;
+            let c = Tree::centre(nd.span[node]);
+            ctx.add_row(i, c, 1.0, &mut nd.sums[node * k..(node + 1) * k]);
+        }
+        if let Some(mut nd) = all_nodes {
+            all.finish(&ctx, &mut nd);
+            let _ = all.nodes.set(nd);
+        }
+        for (t, mut nd) in subj.iter().zip(subj_nodes) {
+            t.finish(&ctx, &mut nd);
+            let _ = t.nodes.set(nd);
+        }
+        SortedRows {
+            ctx,
             all,
             key_subject,
             subj,
         }
     }
 
+    /// The relation's sorted form.
+    pub fn form(&self) -> &'a dyn SortedProfile {
+        self.ctx.form
+    }
+
     /// The distinct keys of the rows of the subjects with `include[s]`, ascending.
     pub fn distinct_keys(&self, include: &[bool]) -> Vec<f64> {
-        let mut out: Vec<f64> = Vec::new();
+        let mut out: Vec<f64> = Vec::with_capacity(self.all.keys.len());
+        // NaN: the first key is always new (as `out.last() != Some(&k)` had it).
+        let mut last = f64::NAN;
         for (&k, &s) in self.all.keys.iter().zip(&self.key_subject) {
-            if include[s as usize] && out.last() != Some(&k) {
+            if include[s as usize] && k != last {
                 out.push(k);
+                last = k;
             }
         }
         out
@@ -356,9 +495,7 @@ impl Query<'_> {
         let sr = self.sr;
         let a = tree.lower(r.lo, r.lo_inclusive);
         let b = tree.upper(r.hi, r.hi_inclusive);
-        let span = |a, b, out: &mut FeatureSums| {
-            tree.add_span(sr.form, &sr.scale, sr.k, &sr.data, a, b, centre, mult, out)
-        };
+        let span = |a, b, out: &mut FeatureSums| tree.add_span(&sr.ctx, a, b, centre, mult, out);
         match self.remove {
             None => span(a, b, out),
             Some((c1, c2)) => {
@@ -412,7 +549,10 @@ fn solve_sorted(
                     members: Members::List(&one),
                     remove,
                 };
-                let ne = sr.form.normal_equations(p, &lay.free, &sr.scale, &q);
+                let ne = sr
+                    .ctx
+                    .form
+                    .normal_equations(p, &lay.free, &sr.ctx.scale, &q);
                 if ne.nb != lay.nb {
                     return None;
                 }
@@ -437,7 +577,10 @@ fn solve_sorted(
                 members,
                 remove,
             };
-            let ne = sr.form.normal_equations(p, &lay.free, &sr.scale, &q);
+            let ne = sr
+                .ctx
+                .form
+                .normal_equations(p, &lay.free, &sr.ctx.scale, &q);
             if ne.nb != nc {
                 return None;
             }
@@ -500,7 +643,7 @@ impl Profiler<'_> {
     /// The sorted source when breakpoint `i` is discrete.
     fn discrete(&self, i: usize) -> Option<Discrete<'_>> {
         match self.src {
-            Source::Sorted { sr, members, keys } if sr.form.discrete_breakpoint(i) => {
+            Source::Sorted { sr, members, keys } if sr.ctx.form.discrete_breakpoint(i) => {
                 Some(Discrete {
                     pr: self,
                     sr,
@@ -866,7 +1009,7 @@ pub(super) fn refit(
                 include[s] = true;
             }
             keys = sr.distinct_keys(&include);
-            plan = sr.form.plan_sorted(&keys);
+            plan = sr.ctx.form.plan_sorted(&keys);
             (n_subj, map) = (list.len(), Vec::new());
         }
     }
@@ -914,6 +1057,75 @@ pub(super) fn refit(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::relations::{Relation, RunTflightSf};
+
+    #[test]
+    fn radix_sort_orders_like_a_comparison_sort() {
+        // Many ties in the high bits (keys from a small set) and negative keys; the low bits
+        // ascend with the position, as `SortedRows::new` builds them.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for n in [10usize, 5000, 70_000] {
+            let v: Vec<u128> = (0..n)
+                .map(|i| {
+                    let key = match next() % 3 {
+                        0 => ((next() % 50) as f64) * 0.5 - 3.0,
+                        1 => 150.0 + (next() % 1_000_000) as f64 * 1e-4,
+                        _ => f64::from_bits(next() >> 2),
+                    };
+                    ((ordered_bits(key) as u128) << 64) | ((i as u128) << 32) | (next() % 7) as u128
+                })
+                .collect();
+            let mut a = v.clone();
+            a.sort_unstable();
+            let mut b = v;
+            sort_by_high_bits(&mut b);
+            assert!(a == b, "n = {n}");
+        }
+    }
+
+    #[test]
+    fn the_lazy_tree_over_all_rows_equals_the_eager_one() {
+        let rel = RunTflightSf::published();
+        let form = rel.sorted_profile().expect("sorted form");
+        let mut prep = Prepared::default();
+        for i in 0..3000usize {
+            let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
+            prep.obs.push(Observation {
+                x: [sf, 0.0, 0.0, 0.0],
+                y: 0.1 + 1e-4 * (sf - 200.0) + 1e-3 * ((i % 13) as f64 - 6.0),
+            });
+            prep.subject.push(i % 4);
+            prep.weights.push(1.0 + (i % 3) as f64);
+        }
+        prep.subjects = (0..4).map(|s| format!("s{s}")).collect();
+        let eager = SortedRows::new(form, &prep, true);
+        let lazy = SortedRows::new(form, &prep, false);
+        assert!(lazy.all.nodes.get().is_none());
+        for (lo, hi) in [
+            (140.0, 260.0),
+            (170.3, 181.05),
+            (199.95, 200.0),
+            (230.0, 231.0),
+        ] {
+            for members in [Members::All, Members::AllBut(2)] {
+                let r = KeyRange::closed(lo, hi);
+                let q = |sr| Query {
+                    sr,
+                    members,
+                    remove: None,
+                };
+                let (a, b) = (q(&eager).range(r, lo), q(&lazy).range(r, lo));
+                assert!(a == b, "[{lo}, {hi}]");
+            }
+        }
+        assert!(lazy.all.nodes.get().is_some());
+    }
 
     #[test]
     fn ordered_bits_sort_like_total_cmp_and_invert() {
