@@ -62,10 +62,9 @@ events build them) is in the `data/*.csv` tables.
   the walking speed; on a treadmill the belt velocity, measured from the toe marker in
   mid-stance, is removed first): it marks the end of the heel's deceleration, not its largest
   lead on the pelvis. No per-method offset is applied.
-- **Foot-speed vs Zeni against the plates, per data set** (detected − force, mean ± SD; the
-  event rows are those of the `--compare force` tables below; double support from
-  `cargo test --release --test events_foot_speed -- --ignored --nocapture`, over the double
-  supports the plates saw whole, in % of the gait cycle):
+- **Foot-speed vs Zeni against the plates, per data set** (detected − force, mean ± SD (n),
+  copied from the `--compare force` tables below; double support over the double supports the
+  plates saw whole, in % of the gait cycle):
 
   | data set | method | heel strike ms | toe off ms | double support % cycle |
   |---|---|---|---|---|
@@ -121,7 +120,10 @@ Per event type: matched events n, detection F1 (only where the plates see every 
 for overground plates, where an unmatched kinematic event may be a step beside the plates),
 recall, and the timing error detected − force (mean ± SD, ms). `file_events` are the events
 stored in the C3D files. Reference events within the tolerance of either end of the marker
-record are not judged.
+record are not judged. The second table of each comparison is the double support: every
+double support the plates saw whole (a heel strike and the other foot's toe off within
+0.3 s), its length by the method's matched events minus the plates', in ms and in % of the
+gait cycle (the median interval between one foot's heel strikes).
 EOF
 run "Schreiber & Moissenet (2019), overground, two plates" schreiber2019 --compare force
 run "BMClab walks, overground, seven plates" bmclab/walk1.trc bmclab/walk2.trc --compare force

@@ -39,6 +39,14 @@ fn compare_force(inputs: &[&str]) -> (CompareTable, f64, f64) {
         );
     }
     let mean_pct = |ds: &[(f64, f64)]| mean_sd(&ds.iter().map(|d| d.1).collect::<Vec<_>>()).0;
+    // `gaitfit events --compare force` prints the same double-support errors (computed by the
+    // library's own matching): they must agree with this independent computation.
+    for (method, ds) in [("foot_speed", &ds_fs), ("zeni_coordinate", &ds_z)] {
+        let lib = &all.double_support[&(method.to_string(), "force".to_string())];
+        assert_eq!(lib.errors_s.len(), ds.len(), "{method}");
+        let (m, _) = lib.pct_cycle();
+        assert!((m.unwrap() - mean_pct(ds)).abs() < 1e-9, "{method}");
+    }
     (all, mean_pct(&ds_fs), mean_pct(&ds_z))
 }
 

@@ -154,11 +154,112 @@ pub fn compare(
     out
 }
 
-/// A table of comparisons accumulated over trials: `(method, reference, kind) → counts`.
+/// Double-support errors (detected − reference) of the double supports the reference saw
+/// whole: a heel strike of one foot followed within 0.3 s by the other foot's toe off, both
+/// inside `span` and both matched by a detected event of the same foot and kind within `tol_s`
+/// (the nearest). Each error is `(seconds, fraction of the gait cycle)`, the cycle being the
+/// median interval between successive heel strikes of one foot in `detected` (else in
+/// `reference`); none when neither gives a cycle.
+pub fn double_support_errors(
+    detected: &[GaitEvent],
+    reference: &[GaitEvent],
+    span: (f64, f64),
+    tol_s: f64,
+) -> Vec<(f64, f64)> {
+    let cycle = |ev: &[GaitEvent]| -> Option<f64> {
+        let mut c: Vec<f64> = Vec::new();
+        for side in [Side::Left, Side::Right] {
+            let mut hs: Vec<f64> = ev
+                .iter()
+                .filter(|e| e.side == side && e.kind == EventKind::HeelStrike)
+                .map(|e| e.time_s)
+                .collect();
+            hs.sort_by(f64::total_cmp);
+            c.extend(hs.windows(2).map(|w| w[1] - w[0]));
+        }
+        c.sort_by(f64::total_cmp);
+        c.get(c.len() / 2).copied()
+    };
+    let Some(cycle) = cycle(detected).or_else(|| cycle(reference)) else {
+        return Vec::new();
+    };
+    let nearest = |side: Side, kind: EventKind, t: f64| -> Option<f64> {
+        detected
+            .iter()
+            .filter(|e| e.side == side && e.kind == kind && (e.time_s - t).abs() <= tol_s)
+            .map(|e| e.time_s)
+            .min_by(|a, b| (a - t).abs().total_cmp(&(b - t).abs()))
+    };
+    let inside = |t: f64| t >= span.0 && t <= span.1;
+    let mut out = Vec::new();
+    for h in reference
+        .iter()
+        .filter(|e| e.kind == EventKind::HeelStrike && inside(e.time_s))
+    {
+        let to = reference
+            .iter()
+            .filter(|e| {
+                e.kind == EventKind::ToeOff
+                    && e.side != h.side
+                    && e.time_s > h.time_s
+                    && e.time_s < h.time_s + 0.3
+                    && inside(e.time_s)
+            })
+            .min_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        let Some(to) = to else { continue };
+        if let (Some(dh), Some(dt)) = (
+            nearest(h.side, EventKind::HeelStrike, h.time_s),
+            nearest(to.side, EventKind::ToeOff, to.time_s),
+        ) {
+            let err = (dt - dh) - (to.time_s - h.time_s);
+            out.push((err, err / cycle));
+        }
+    }
+    out
+}
+
+/// Double-support errors of one method against one reference, accumulated over trials.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct DoubleSupportCounts {
+    /// Errors, detected − reference, s.
+    pub errors_s: Vec<f64>,
+    /// The same errors as fractions of the gait cycle.
+    pub errors_cycle: Vec<f64>,
+}
+
+fn mean_sd(v: &[f64]) -> (Option<f64>, Option<f64>) {
+    let n = v.len();
+    if n == 0 {
+        return (None, None);
+    }
+    let m = v.iter().sum::<f64>() / n as f64;
+    let sd =
+        (n > 1).then(|| (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1) as f64).sqrt());
+    (Some(m), sd)
+}
+
+impl DoubleSupportCounts {
+    /// Mean and sample SD of the error, ms.
+    pub fn ms(&self) -> (Option<f64>, Option<f64>) {
+        let (m, sd) = mean_sd(&self.errors_s);
+        (m.map(|x| x * 1000.0), sd.map(|x| x * 1000.0))
+    }
+    /// Mean and sample SD of the error, % of the gait cycle.
+    pub fn pct_cycle(&self) -> (Option<f64>, Option<f64>) {
+        let (m, sd) = mean_sd(&self.errors_cycle);
+        (m.map(|x| x * 100.0), sd.map(|x| x * 100.0))
+    }
+}
+
+/// A table of comparisons accumulated over trials: `(method, reference, kind) → counts`, and
+/// the double-support errors per `(method, reference)`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CompareTable {
     /// The accumulated counts.
     pub rows: BTreeMap<(String, String, EventKind), KindCounts>,
+    /// The accumulated double-support errors (see [`double_support_errors`]).
+    #[serde(default)]
+    pub double_support: BTreeMap<(String, String), DoubleSupportCounts>,
 }
 
 impl CompareTable {
@@ -172,10 +273,25 @@ impl CompareTable {
         }
     }
 
+    /// Adds the double-support errors of one method (see [`double_support_errors`]).
+    pub fn add_double_support(&mut self, method: &str, reference: &str, errors: &[(f64, f64)]) {
+        let d = self
+            .double_support
+            .entry((method.to_string(), reference.to_string()))
+            .or_default();
+        d.errors_s.extend(errors.iter().map(|e| e.0));
+        d.errors_cycle.extend(errors.iter().map(|e| e.1));
+    }
+
     /// Adds every row of another table.
     pub fn merge(&mut self, other: &CompareTable) {
         for (k, c) in &other.rows {
             self.rows.entry(k.clone()).or_default().merge(c);
+        }
+        for (k, d) in &other.double_support {
+            let e = self.double_support.entry(k.clone()).or_default();
+            e.errors_s.extend_from_slice(&d.errors_s);
+            e.errors_cycle.extend_from_slice(&d.errors_cycle);
         }
     }
 
@@ -198,6 +314,27 @@ impl CompareTable {
                 f(c.mean_ms(), 1),
                 f(c.sd_ms(), 1)
             ));
+        }
+        if self.double_support.values().any(|d| !d.errors_s.is_empty()) {
+            s.push_str(&format!(
+                "\n{:<16} {:<10} {:<14} {:>5} {:>17} {:>19}\n",
+                "method", "vs", "period", "n", "error ms (mean±SD)", "error % of cycle"
+            ));
+            for ((m, r), d) in &self.double_support {
+                let (ms, ms_sd) = d.ms();
+                let (p, p_sd) = d.pct_cycle();
+                s.push_str(&format!(
+                    "{:<16} {:<10} {:<14} {:>5} {:>9} ± {:<6} {:>9} ± {:<6}\n",
+                    m,
+                    r,
+                    "double_support",
+                    d.errors_s.len(),
+                    f(ms, 1),
+                    f(ms_sd, 1),
+                    f(p, 2),
+                    f(p_sd, 2)
+                ));
+            }
         }
         s
     }
@@ -252,6 +389,44 @@ mod tests {
         let m = compare(&d, &r, Coverage::MatchedOnly, (0.0, 10.0), 0.06);
         assert_eq!(m[&EventKind::HeelStrike].f1(), None);
         assert_eq!(m[&EventKind::HeelStrike].recall(), Some(1.0));
+    }
+
+    fn ev(t: f64, side: Side, kind: EventKind) -> GaitEvent {
+        GaitEvent {
+            time_s: t,
+            side,
+            kind,
+            source: EventSource::Force,
+        }
+    }
+
+    #[test]
+    fn double_support_error_in_time_and_cycle() {
+        use EventKind::{HeelStrike as H, ToeOff as T};
+        use Side::{Left as L, Right as R};
+        // Reference: right heel strike at 1.00, left toe off at 1.10 (0.10 s double support).
+        let r = vec![ev(1.0, R, H), ev(1.1, L, T), ev(1.6, L, H)];
+        // Detected: heel strike 8 ms early, toe off 4 ms late; cycle 1.1 s (left heel strikes).
+        let d = vec![
+            ev(0.5, L, H),
+            ev(0.992, R, H),
+            ev(1.104, L, T),
+            ev(1.6, L, H),
+        ];
+        let e = double_support_errors(&d, &r, (0.0, 10.0), 0.06);
+        assert_eq!(e.len(), 1);
+        assert!((e[0].0 - 0.012).abs() < 1e-12);
+        assert!((e[0].1 - 0.012 / 1.1).abs() < 1e-12);
+        // A toe off outside the tolerance: no pair; outside the span: no pair.
+        let far = vec![ev(0.5, L, H), ev(0.992, R, H), ev(1.2, L, T), ev(1.6, L, H)];
+        assert!(double_support_errors(&far, &r, (0.0, 10.0), 0.06).is_empty());
+        assert!(double_support_errors(&d, &r, (0.0, 1.05), 0.06).is_empty());
+        let mut t = CompareTable::default();
+        t.add_double_support("m", "force", &e);
+        t.add_double_support("m", "force", &[(0.002, 0.002)]);
+        let (m, sd) = t.double_support[&("m".into(), "force".into())].ms();
+        assert!((m.unwrap() - 7.0).abs() < 1e-9);
+        assert!((sd.unwrap() - 50f64.sqrt()).abs() < 1e-9);
     }
 
     #[test]

@@ -527,11 +527,17 @@ impl Analysis {
             }
             let res = compare::compare(det, refs, coverage, span, tol_s);
             table.add(name, rname, &res);
+            if reference == EventSource::Force {
+                let ds = compare::double_support_errors(det, refs, span, tol_s);
+                table.add_double_support(name, rname, &ds);
+            }
         }
         // The file's own events against the plates: what justifies building steps from them.
         if reference == EventSource::Force && !self.events.reference.is_empty() {
             let res = compare::compare(&self.events.reference, refs, coverage, span, tol_s);
             table.add("file_events", rname, &res);
+            let ds = compare::double_support_errors(&self.events.reference, refs, span, tol_s);
+            table.add_double_support("file_events", rname, &ds);
         }
         table
     }
