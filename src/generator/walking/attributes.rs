@@ -156,6 +156,10 @@ attributes! {
     ankle_swing_dorsiflexion_max_deg: 115.0, [90.0, 140.0], "deg";
     /// Knee flexion at toe-off, reached through the meta-off period (θ5 at toe-off follows).
     knee_toe_off_deg: 35.0, [0.0, 80.0], "deg";
+    /// Shortest heel rocker (heel strike → foot flat), fraction of the step: the foot lowers
+    /// onto the ground along a C¹ blend of this duration (longer when the leg, straight, could
+    /// not yet reach a flatter foot), instead of slapping down the moment the leg can reach.
+    heel_rocker_fraction: 0.15, [0.02, 0.6], "1";
     /// Ankle dorsiflexion limit θ5 that ends the normal period and starts heel-off (§4.2).
     ankle_dorsiflexion_max_deg: 100.0, [90.0, 125.0], "deg";
     /// Metatarsal (toe) joint limit θ6 that ends heel-off and starts meta-off (§4.2).

@@ -13,7 +13,7 @@ use super::foot::FootShape;
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::swing::{SwingRun, SwingSpec, SwingStart};
-use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
+use super::virtual_leg::{smooth_roll, FootPeriod, LegPose, VirtualLeg};
 use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
 use crate::generator::ik::leg_ik;
 use crate::generator::motion::{Motion, MotionMetadata};
@@ -366,6 +366,7 @@ pub fn generate_steps(
         rho,
         meta_start: None,
         transitions: [None; 3],
+        rocker: None,
     };
     let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
     let mut trailing_clock = 0.0;
@@ -515,11 +516,17 @@ pub fn generate_steps(
                 .unwrap_or(times.double_support);
         let zf_s = side_z(stance_side, a);
         let n_s = ((t_step / dt_v).ceil() as usize).max(2);
+        let hips: Vec<(f64, [f64; 2], f64)> = (0..=n_s)
+            .map(|i| {
+                let t = t_step * i as f64 / n_s as f64;
+                let (hp, hz) = stance_hip(t);
+                (t, hp, hz - zf_s)
+            })
+            .collect();
+        stance_leg.plan_heel_rocker(&hips, a.heel_rocker_fraction * t_step);
         let mut stance_rho = Vec::with_capacity(n_s + 1);
-        for i in 0..=n_s {
-            let t = t_step * i as f64 / n_s as f64;
-            let (hp, hz) = stance_hip(t);
-            let p = stance_leg.advance(t, hp, hz - zf_s);
+        for &(t, hp, dz) in &hips {
+            let p = stance_leg.advance(t, hp, dz);
             stance_rho.push((t, p.rho));
         }
         // 4. Swing.
@@ -642,8 +649,63 @@ pub fn generate_steps(
         t_global += t_step;
         from_rest = false;
     }
+    smooth_rolls(&mut data);
     let motion = assemble(&skeleton, &body, &foot, &data, opt, t_global)?;
     Ok((motion, report))
+}
+
+/// Forward-mean window of the stance roll after foot flat, s (see [`smooth_roll`]).
+const ROLL_WINDOW: f64 = 0.05;
+
+/// Smooths every leg's recorded roll from foot flat to toe-off ([`smooth_roll`], two passes of
+/// [`ROLL_WINDOW`]): one leg's stance is recorded in two steps (its own, then the next step's
+/// double support), so the two pieces are joined, smoothed and split again.
+fn smooth_rolls(data: &mut [StepData]) {
+    let smooth = |times: &[f64], rho: &mut Vec<f64>| {
+        let from = rho.iter().position(|&r| r >= 0.0).unwrap_or(rho.len());
+        smooth_roll(times, rho, from, ROLL_WINDOW, 2);
+    };
+    // The first step's trailing leg: its stance before the walk is not recorded.
+    if let Some(d) = data.first_mut() {
+        let times: Vec<f64> = d.trail_rho.iter().map(|s| s.0).collect();
+        let mut rho: Vec<f64> = d.trail_rho.iter().map(|s| s.1).collect();
+        smooth(&times, &mut rho);
+        for (s, r) in d.trail_rho.iter_mut().zip(rho) {
+            s.1 = r;
+        }
+    }
+    for k in 0..data.len() {
+        let start = data[k].start;
+        let mut times: Vec<f64> = data[k].stance_rho.iter().map(|s| start + s.0).collect();
+        let mut rho: Vec<f64> = data[k].stance_rho.iter().map(|s| s.1).collect();
+        let n1 = times.len();
+        let mut skipped = 0;
+        if let Some(next) = data.get(k + 1) {
+            for &(t, r) in &next.trail_rho {
+                let g = next.start + t;
+                if times.last().is_some_and(|&l| g <= l + 1e-12) {
+                    skipped += 1;
+                    continue;
+                }
+                times.push(g);
+                rho.push(r);
+            }
+        }
+        smooth(&times, &mut rho);
+        for (s, &r) in data[k].stance_rho.iter_mut().zip(&rho[..n1]) {
+            s.1 = r;
+        }
+        if let Some(next) = data.get_mut(k + 1) {
+            let last = rho[n1.saturating_sub(1)];
+            for (i, s) in next.trail_rho.iter_mut().enumerate() {
+                s.1 = if i < skipped {
+                    last
+                } else {
+                    rho[n1 + i - skipped]
+                };
+            }
+        }
+    }
 }
 
 /// Builds the frames.

@@ -95,6 +95,107 @@ pub struct VirtualLeg {
     pub meta_start: Option<(f64, f64)>,
     /// Times the periods began (foot flat, heel off, meta off), s.
     pub transitions: [Option<f64>; 3],
+    /// The planned heel rocker (see [`VirtualLeg::plan_heel_rocker`]); `None`: the foot
+    /// lowers as fast as the straight leg allows.
+    pub rocker: Option<HeelRocker>,
+}
+
+/// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
+/// `end`, when it is flat (see [`VirtualLeg::plan_heel_rocker`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeelRocker {
+    /// When the foot is flat, s (leg clock).
+    pub end: f64,
+    /// `(t, ρ)` samples up to `end`.
+    pub table: Vec<(f64, f64)>,
+}
+
+impl HeelRocker {
+    /// The roll `ρ` at `t` (linear between samples, 0 from `end` on).
+    pub fn rho_at(&self, t: f64) -> f64 {
+        if t >= self.end {
+            return 0.0;
+        }
+        let k = self.table.partition_point(|s| s.0 <= t);
+        if k == 0 {
+            return self.table.first().map_or(0.0, |s| s.1);
+        }
+        let (a, b) = match self.table.get(k) {
+            Some(&b) => (self.table[k - 1], b),
+            None => (self.table[k - 1], (self.end, 0.0)),
+        };
+        if b.0 <= a.0 {
+            return b.1;
+        }
+        a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0)
+    }
+}
+
+/// Knee flexion of a two-link leg (`l3`, `l4`) spanning `d`, rad.
+fn knee_for(l3: f64, l4: f64, d: f64) -> f64 {
+    let dc = d.clamp((l3 - l4).abs() + 1e-12, l3 + l4);
+    std::f64::consts::PI
+        - ((l3 * l3 + l4 * l4 - dc * dc) / (2.0 * l3 * l4))
+            .clamp(-1.0, 1.0)
+            .acos()
+}
+
+/// Length of a two-link leg with knee flexion `knee`, m.
+fn span_for(l3: f64, l4: f64, knee: f64) -> f64 {
+    (l3 * l3 + l4 * l4 + 2.0 * l3 * l4 * knee.cos())
+        .max(0.0)
+        .sqrt()
+}
+
+/// Smooths the stance foot's roll after it is flat: `rho` (non-decreasing, sampled at the
+/// increasing `times`) is replaced from sample `from` on by its mean over the forward window
+/// `[t, t + w(t)]`, `w(t) = min(window, t − t_from + t_still, t_end − t)`, applied `passes`
+/// times (`t_still`: how long the roll keeps its value at `from`, the flat foot).
+///
+/// Why: the heel-off rule ("just enough roll to keep the ankle within reach") starts the roll
+/// at the rate the telescopic leg lengthens, which KLAW's leg does in a few milliseconds
+/// (heel 3 mm in one frame after standing still: continuity ratios ≈ 30). A forward mean of a
+/// non-decreasing roll is never below it, so the smoothed foot is never out of reach (it rolls
+/// a little earlier, the knee taking up the difference); the shrinking window keeps the first
+/// and last samples (foot flat, toe-off, where the swing takes over) exactly.
+pub fn smooth_roll(times: &[f64], rho: &mut [f64], from: usize, window: f64, passes: usize) {
+    let n = times.len().min(rho.len());
+    if from + 2 >= n {
+        return;
+    }
+    let (t0, t1) = (times[from], times[n - 1]);
+    for _ in 0..passes {
+        let src: Vec<f64> = rho[..n].to_vec();
+        // Time the roll leaves its value at `from` (the flat foot): the window may look that
+        // far ahead from `from` without changing it.
+        let still = src[from..]
+            .iter()
+            .position(|&r| r > src[from])
+            .map_or(t1 - t0, |k| times[from + k - 1] - t0);
+        let at = |t: f64| {
+            let k = times[..n].partition_point(|&x| x <= t).clamp(1, n - 1);
+            let (ta, tb) = (times[k - 1], times[k]);
+            if tb <= ta {
+                return src[k];
+            }
+            src[k - 1] + (src[k] - src[k - 1]) * ((t - ta) / (tb - ta)).clamp(0.0, 1.0)
+        };
+        for i in from..n {
+            let t = times[i];
+            let w = window.min(t - t0 + still).min(t1 - t).max(0.0);
+            if w <= 0.0 {
+                continue;
+            }
+            // Simpson's rule on 16 panels of the piecewise-linear roll.
+            let m = 16;
+            let h = w / m as f64;
+            let mut acc = at(t) + at(t + w);
+            for q in 1..m {
+                acc += if q % 2 == 1 { 4.0 } else { 2.0 } * at(t + q as f64 * h);
+            }
+            rho[i] = (acc * h / 3.0) / w;
+        }
+    }
 }
 
 /// The root of `g` between `pos` (`g > 0`) and `neg` (`g ≤ 0`), to 1e-10, returned from the
@@ -187,6 +288,103 @@ impl VirtualLeg {
         root_nonpositive_side(&g, a, b)
     }
 
+    /// Plans the heel rocker from the hip's path `samples` (`(t, hip, dz)` in time order, the
+    /// leg's clock starting at heel strike with the leg's current roll `ρ = −pitch`).
+    ///
+    /// The paper lets the foot rotate about the heel with the knee straight until it is flat;
+    /// taken literally (the largest roll the straight leg reaches) the foot slaps down within
+    /// 2–5 frames of heel strike (KLAW's hip approaches the foot at ≈ 1 m/s just after the
+    /// collision) and the knee snaps from straight to the flat period's flexion (continuity
+    /// ratios 10–40). Here the *knee* is planned instead: from straight at heel strike it
+    /// flexes along a cubic Hermite curve (leaving at its mean rate) to the flat foot's knee
+    /// flexion and rate at the end `T`; at each sample the roll is the one that puts the ankle
+    /// at the distance that knee spans (clamped to the heel-strike pitch and to flat, never
+    /// decreasing). At `T` the roll reaches 0 at rest (the flat foot's knee is met with its rate),
+    /// so the foot lands without a slap. `T` is the shortest on a ×1.1 grid from `min_duration`
+    /// for which the flat foot's ankle is then within the flat period's soft leg length (so it
+    /// does not roll forward the moment it lands). The ankle is never out of reach (the knee
+    /// only flexes). If no such `T` exists before the last sample, `rocker` stays `None` and the
+    /// straight-leg rule is used. Returns whether a rocker was planned.
+    pub fn plan_heel_rocker(
+        &mut self,
+        samples: &[(f64, [f64; 2], f64)],
+        min_duration: f64,
+    ) -> bool {
+        self.rocker = None;
+        if self.period != FootPeriod::HeelRocker || self.rho >= 0.0 || samples.len() < 3 {
+            return false;
+        }
+        let (l3, l4) = (self.l3, self.l4);
+        let l1 = l3 + l4;
+        let pitch = -self.rho;
+        let dist = |rho: f64, hip: [f64; 2], dz: f64| {
+            let p = self.pose_at(hip, dz, rho);
+            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+            (hip[0] - p.ankle[0]).hypot(dy)
+        };
+        let d_flat: Vec<f64> = samples
+            .iter()
+            .map(|&(_, hip, dz)| dist(0.0, hip, dz))
+            .collect();
+        let a0 = l1 - 2.0 * KNEE_SOFT;
+        let t_first = samples[0].0;
+        let mut duration = min_duration;
+        for _ in 0..30 {
+            let kt = samples.partition_point(|s| s.0 < t_first + duration);
+            if kt + 1 >= samples.len() {
+                return false;
+            }
+            duration *= 1.1;
+            if d_flat[kt] > a0 || d_flat[kt - 1] > a0 || d_flat[kt + 1] > a0 {
+                continue;
+            }
+            let end = samples[kt].0;
+            let big_t = end - t_first;
+            let k_end = knee_for(l3, l4, d_flat[kt]);
+            let k_rate = (knee_for(l3, l4, d_flat[kt + 1]) - knee_for(l3, l4, d_flat[kt - 1]))
+                / (samples[kt + 1].0 - samples[kt - 1].0);
+            let knee_at = |t: f64, start_rate: f64| {
+                let u = (t - t_first) / big_t;
+                let h01 = (3.0 - 2.0 * u) * u * u;
+                let h10 = ((u - 2.0) * u + 1.0) * u;
+                let h11 = (u - 1.0) * u * u;
+                k_end * h01 + big_t * (start_rate * h10 + k_rate * h11)
+            };
+            // The slowest start (mean rate × 1, 1.25, …, 3) whose knee stays at least as flexed
+            // as the flat foot would make it: the foot then lands only at `end`.
+            let Some(start_rate) = [1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0]
+                .iter()
+                .map(|f| f * k_end / big_t)
+                .find(|&r0| {
+                    samples[..kt].iter().zip(&d_flat).all(|(&(t, _, _), &df)| {
+                        knee_at(t, r0) >= knee_for(l3, l4, df.min(l1)) - 1e-6
+                    })
+                })
+            else {
+                continue;
+            };
+            let mut table = Vec::with_capacity(kt);
+            let mut last = -pitch;
+            for &(t, hip, dz) in &samples[..kt] {
+                let knee = knee_at(t, start_rate);
+                let target = span_for(l3, l4, knee.max(0.0)).min(l1);
+                let g = |r: f64| dist(r, hip, dz) - target;
+                let r = if g(0.0) <= 0.0 {
+                    0.0
+                } else if g(-pitch) >= 0.0 {
+                    -pitch
+                } else {
+                    root_nonpositive_side(&g, 0.0, -pitch)
+                };
+                last = r.max(last);
+                table.push((t, last));
+            }
+            self.rocker = Some(HeelRocker { end, table });
+            return true;
+        }
+        false
+    }
+
     /// Advances the rules to time `t` (leg clock) with the hip at `hip` and lateral offset `dz`
     /// and returns the configuration. Calls must come in time order.
     pub fn advance(&mut self, t: f64, hip: [f64; 2], dz: f64) -> LegPose {
@@ -195,6 +393,17 @@ impl VirtualLeg {
             let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
             (hip[0] - p.ankle[0]).hypot(dy) - l1
         };
+        if self.period == FootPeriod::HeelRocker {
+            if let Some((end, rho)) = self.rocker.as_ref().map(|r| (r.end, r.rho_at(t))) {
+                if t < end {
+                    self.rho = rho.max(self.rho);
+                    return self.pose_at(hip, dz, self.rho);
+                }
+                self.period = FootPeriod::Flat;
+                self.rho = 0.0;
+                self.transitions[0] = Some(end);
+            }
+        }
         if self.period == FootPeriod::HeelRocker {
             // Largest ρ ≤ 0 within reach of the straight leg: reach(ρ) increases with ρ here.
             let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip);
