@@ -72,6 +72,8 @@ events build them) is in the `data/*.csv` tables.
   | Schreiber | Zeni coordinate | −34.1 ± 8.1 (11) | −1.0 ± 6.2 (24) | +3.1 ± 1.1 (11) |
   | BMClab walks | foot speed | −7.4 ± 10.4 (7) | +5.2 ± 6.8 (5) | +1.4 ± 0.8 (5) |
   | BMClab walks | Zeni coordinate | −36.1 ± 12.1 (7) | +20.8 ± 7.2 (5) | +5.6 ± 0.9 (5) |
+  | BMClab Gait.c3d | foot speed | −5.9 ± 4.0 (2) | −10.4 ± 3.0 (2) | −1.0 (1) |
+  | BMClab Gait.c3d | Zeni coordinate | −36.9 ± 4.6 (2) | +5.9 ± 3.0 (2) | +3.8 (1) |
 
 - **Winter's walk** (no force data in the file; the data README gives his events, right heel
   strikes at frames 28 and 97, toe off at 70): the foot-speed detector finds frames 27.3, 96.3
@@ -127,6 +129,7 @@ gait cycle (the median interval between one foot's heel strikes).
 EOF
 run "Schreiber & Moissenet (2019), overground, two plates" schreiber2019 --compare force
 run "BMClab walks, overground, seven plates" bmclab/walk1.trc bmclab/walk2.trc --compare force
+run "BMClab Gait.c3d (a Vicon C3D walking sample; two plates, one contact each)" bmclab/Gait.c3d --compare force
 run "BMClab running trial (one contact per foot)" bmclab/motion_capture_run.trc+bmclab/grf_run.mot --compare force
 run "Hamner subject01 (the runner with markers), treadmill" hamner2013/subject01 --compare force
 run "Schreiber: kinematic methods vs the C3D's own events" schreiber2019 --compare reference
