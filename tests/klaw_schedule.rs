@@ -152,3 +152,117 @@ fn schedule_file_reads_and_drives_a_walk() {
         "{e}"
     );
 }
+
+#[test]
+fn the_stop_brings_the_trailing_foot_alongside_and_comes_to_rest() {
+    // From steady walking: a last half step, then the trailing foot lands beside the stance foot
+    // (stride width kept) and the body comes to rest, at 1, 3, 5 and 7 km/h.
+    for v in [1.0, 3.0, 5.0, 7.0] {
+        let opts = WalkOptions {
+            stop: true,
+            ..Default::default()
+        };
+        let (m, r) = generate_walk(&[kmh(v, 4)], &opts).unwrap();
+        each_step_meets_its_own_command(&m, &r);
+        let n = m.len();
+        let fps = m.fps();
+        let last = r.steps.last().unwrap();
+        let t_hs = last.start_s + last.times.step;
+        // The walk goes on after the last heel strike: the trailing foot's toe off and landing.
+        let trail = last.stance_side;
+        let landing = m
+            .events
+            .iter()
+            .find(|e| e.side == trail && e.kind == EventKind::HeelStrike && e.time_s > t_hs)
+            .unwrap_or_else(|| panic!("{v} km/h: no landing of the trailing foot"));
+        assert!(m
+            .events
+            .iter()
+            .any(|e| e.side == trail && e.kind == EventKind::ToeOff && e.time_s > t_hs));
+        assert!(
+            (landing.time_s * fps) < (n - 1) as f64,
+            "{v} km/h: the motion ends before the landing"
+        );
+        // Feet side by side at the end: heels and toes level along the walk within 1 cm, the
+        // stride width kept (1 mm), both flat on the ground and in contact.
+        let p = |lm: Landmark| m.landmark(n - 1, lm);
+        for (l, r_) in [
+            (Landmark::LHeel, Landmark::RHeel),
+            (Landmark::LToe, Landmark::RToe),
+        ] {
+            let (a, b) = (p(l), p(r_));
+            assert!((a.x - b.x).abs() < 0.01, "{v} km/h: {l:?} {a} vs {b}");
+            assert!(
+                ((a.z - b.z).abs() - opts.attributes.stride_width_m).abs() < 1e-3,
+                "{v} km/h: stride width {}",
+                (a.z - b.z).abs()
+            );
+            assert!(a.y.abs() < 1e-3 && b.y.abs() < 1e-3, "{v} km/h: {a} {b}");
+        }
+        assert!(m.contact(n - 1, Side::Left) && m.contact(n - 1, Side::Right));
+        // At rest at the end: every landmark still over the last 0.1 s.
+        let k = (0.1 * fps) as usize;
+        let lms = m.all_landmarks();
+        for (a, b) in lms[n - 1 - k].iter().zip(&lms[n - 1]) {
+            assert!((*a - *b).length() < 1e-9, "{v} km/h: moving at the end");
+        }
+        // Smoothly: the pelvis never steps back, its speed does not jump at the last heel strike
+        // (the closing starts from the dynamic state there) and its deceleration stays bounded.
+        let pel: Vec<_> = (0..n).map(|i| m.landmark(i, Landmark::Pelvis)).collect();
+        let vel: Vec<_> = pel.windows(2).map(|w| (w[1] - w[0]) * fps).collect();
+        let f_hs = (t_hs * fps).floor() as usize;
+        let mut worst_acc: f64 = 0.0;
+        for i in f_hs.saturating_sub(5)..vel.len() {
+            assert!(
+                vel[i].x > -1e-9,
+                "{v} km/h: pelvis moves back at frame {i}: {}",
+                vel[i].x
+            );
+            if i > 0 {
+                worst_acc = worst_acc.max((vel[i] - vel[i - 1]).length() * fps);
+            }
+        }
+        // Measured 1.0 / 2.9 / 5.4 / 8.7 m/s² at 1 / 3 / 5 / 7 km/h (the last half step ends
+        // with the hip still moving at 0.3–1.6 m/s, a few centimetres behind its resting place).
+        assert!(
+            worst_acc < 15.0,
+            "{v} km/h: pelvis acceleration {worst_acc} m/s²"
+        );
+    }
+}
+
+#[test]
+fn the_cli_stop_ends_with_the_trailing_foot_landing() {
+    let dir = tempfile::tempdir().unwrap();
+    assert_cmd::Command::cargo_bin("gaitfit")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["generate", "walk", "--speed", "5km/h", "--seconds", "3"])
+        .args(["--stop", "-o", "walk.csv"])
+        .assert()
+        .success();
+    let events = std::fs::read_to_string(dir.path().join("walk_events.csv")).unwrap();
+    let rows: Vec<&str> = events.lines().skip(1).collect();
+    // The last events: the trailing foot's toe off, then its landing (heel strike and foot flat
+    // at once) beside the stance foot.
+    let n = rows.len();
+    assert!(n >= 3, "{events}");
+    let (side, _) = rows[n - 1]
+        .split_once(",")
+        .unwrap()
+        .1
+        .split_once(",")
+        .unwrap();
+    assert!(
+        rows[n - 2].ends_with(&format!("{side},heel_strike")),
+        "{events}"
+    );
+    assert!(
+        rows[n - 1].ends_with(&format!("{side},foot_flat")),
+        "{events}"
+    );
+    assert!(
+        rows[n - 3].ends_with(&format!("{side},toe_off")),
+        "{events}"
+    );
+}

@@ -47,7 +47,8 @@ pub struct Args {
     /// Start standing (the first step is a half step from rest).
     #[arg(long = "from-rest")]
     pub from_rest: bool,
-    /// End with a half step.
+    /// End standing: a last half step, then the trailing foot is brought alongside and the body
+    /// comes to rest.
     #[arg(long)]
     pub stop: bool,
     /// Output file: `.bvh`, `.csv` (plus `<stem>_events.csv`) or `.trc`.

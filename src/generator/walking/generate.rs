@@ -12,6 +12,7 @@ use super::dynamics::{HipMotion, StanceModel};
 use super::foot::FootShape;
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
+use super::stop::{Closing, StopStart};
 use super::swing::{SwingRun, SwingSpec, SwingStart};
 use super::virtual_leg::{smooth_roll, FootPeriod, LegPose, VirtualLeg};
 use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
@@ -37,7 +38,8 @@ pub struct WalkOptions {
     pub fps: f64,
     /// Start from standing (the first step is a half step from rest).
     pub start_from_rest: bool,
-    /// End standing (a last half step, then the trailing foot is brought alongside).
+    /// End standing: a last half step, then the trailing foot is brought alongside and the body
+    /// comes to rest ([`super::stop`]).
     pub stop: bool,
 }
 
@@ -650,7 +652,52 @@ pub fn generate_steps(
         from_rest = false;
     }
     smooth_rolls(&mut data);
-    let motion = assemble(&skeleton, &body, &foot, &data, opt, t_global)?;
+    // The stop: the trailing foot is brought alongside and the body comes to rest.
+    let closing = match (opt.stop, data.last()) {
+        (true, Some(d)) => {
+            let w = stance_side;
+            let (q, qd, qdd) = d.stance.track.at(d.times.step);
+            let h = StanceModel::hip(&q, &qd, &qdd);
+            let sgn = Determinants::side_sign(w);
+            let om = PI / d.times.step;
+            let geo = StopStart {
+                hip: [
+                    [d.ankle_x + h.pos[0], h.vel[0], h.acc[0]],
+                    [body.l9 + h.pos[1], h.vel[1], h.acc[1]],
+                ],
+                // d/dt of the last step's lateral_at at its end (sin(π) = 0, cos(π) = −1).
+                lateral: [
+                    d.det.lateral_at(d.times.step),
+                    sgn * d.det.lateral * om,
+                    0.0,
+                ],
+                lean: [q[2], qd[2], qdd[2]],
+                lean_ref: a.trunk_lean_deg.to_radians(),
+                stance_ankle_x: ankle_x[idx(w)],
+                ankle_height: body.l9,
+                hip_z: [sgn * half_width, -sgn * half_width],
+                ankle_z: [side_z(w, a), side_z(w.opposite(), a)],
+                l1: body.l1,
+                t_ds: d.times.double_support,
+                t_swing: d.times.swing,
+                clearance: a.toe_clearance_m,
+                trail_clock: trailing_clock,
+                min_knee_blend: MIN_KNEE_BLEND * d.times.double_support,
+            };
+            let lead = mk_leg(ankle_x[idx(w)], FootPeriod::HeelRocker, -prev_hs_pitch);
+            Some(Closing::new(
+                t_global,
+                w,
+                geo,
+                lead,
+                trailing.clone(),
+                &foot,
+            ))
+        }
+        _ => None,
+    };
+    let total = t_global + closing.as_ref().map_or(0.0, |c| c.duration);
+    let motion = assemble(&skeleton, &body, &foot, &data, opt, total, closing.as_ref())?;
     Ok((motion, report))
 }
 
@@ -716,6 +763,7 @@ fn assemble(
     data: &[StepData],
     opt: &WalkOptions,
     total: f64,
+    closing: Option<&Closing>,
 ) -> Result<Motion, GenerateError> {
     let a = &opt.attributes;
     let mut meta = MotionMetadata::new("klaw", Some(Gait::Walk));
@@ -733,6 +781,11 @@ fn assemble(
     let swing_model = super::dynamics::SwingModel::new(body);
     for i in 0..frames {
         let t = (i as f64 / opt.fps).min(total);
+        if let Some(c) = closing.filter(|c| t > c.start) {
+            let (pose, contact) = closing_pose(skeleton, foot, c, t, a);
+            motion.push_frame(pose, contact);
+            continue;
+        }
         let k = data.partition_point(|d| d.start <= t).saturating_sub(1);
         let d = &data[k];
         let tau = (t - d.start).clamp(0.0, d.times.step);
@@ -874,12 +927,77 @@ fn assemble(
             EventKind::HeelStrike,
         ));
     }
+    if let Some(c) = closing {
+        let (w, tr) = (c.stance, c.stance.opposite());
+        if let Some(tf) = c.stance_flat {
+            events.push(ev(c.start + tf, w, EventKind::FootFlat));
+        }
+        for (tt, kind) in c
+            .trail_transitions
+            .iter()
+            .zip([EventKind::HeelOff, EventKind::MetaOff])
+        {
+            if let Some(tt) = tt {
+                events.push(ev(c.start + tt, tr, kind));
+            }
+        }
+        events.push(ev(c.start + c.toe_off, tr, EventKind::ToeOff));
+        // The trailing foot lands flat beside the stance foot: heel strike and foot flat at once.
+        events.push(ev(c.start + c.landing, tr, EventKind::HeelStrike));
+        events.push(ev(c.start + c.landing, tr, EventKind::FootFlat));
+    }
     events.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
     events.dedup_by(|x, y| {
         x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9
     });
     motion.events = events;
     Ok(motion)
+}
+
+/// One frame of the stop ([`Closing`]): pelvis level and unrotated, trunk returning to its lean,
+/// arms following the opposite thighs as in the walk.
+fn closing_pose(
+    skeleton: &Skeleton,
+    foot: &FootShape,
+    c: &Closing,
+    t: f64,
+    a: &WalkAttributes,
+) -> (crate::generator::skeleton::Pose, [bool; 2]) {
+    let f = c.frame(t - c.start, foot);
+    let mut pose = skeleton.rest_pose();
+    pose.root = DVec3::new(f.hip[0], f.hip[1], f.lateral);
+    let (w, tr) = (c.stance, c.stance.opposite());
+    let place =
+        |pose: &mut crate::generator::skeleton::Pose, side: Side, ft: ([f64; 2], f64, f64)| {
+            let (ankle, pitch, bend) = ft;
+            place_leg(
+                skeleton,
+                pose,
+                side,
+                [ankle[0], ankle[1], side_z(side, a)],
+                pitch,
+                bend,
+            )
+        };
+    let stance_thigh = place(&mut pose, w, f.stance_foot);
+    let trail_thigh = place(&mut pose, tr, f.trail_foot);
+    pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_z(-f.lean));
+    pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, 0.0));
+    pose.set_world_rotation(Joint::Head, DQuat::IDENTITY);
+    let arm_gain = a.arm_swing_deg / 25.0;
+    for (side, opposite_thigh) in [(w, trail_thigh), (tr, stance_thigh)] {
+        let [_, shoulder, elbow, _] = Joint::arm(side);
+        let flex = -arm_gain * opposite_thigh;
+        pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
+        let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
+        pose.set_euler(elbow, Euler::sagittal(elbow_flex));
+    }
+    let mut contact = [true; 2];
+    contact[match tr {
+        Side::Left => 0,
+        Side::Right => 1,
+    }] = f.trail_contact;
+    (pose, contact)
 }
 
 /// Thigh angle θ3 and knee flexion θ4 of the sagittal two-link chain from `hip` to `ankle`.

@@ -44,6 +44,7 @@ pub mod integrate;
 pub mod lagrange;
 pub mod shooting;
 pub mod stance;
+pub mod stop;
 pub mod swing;
 pub mod track;
 pub mod virtual_leg;
@@ -84,7 +85,8 @@ pub fn steps_for_duration(
 
 /// Generates a walk: the schedule's stretches one after the other, with accelerations and
 /// decelerations at one-step granularity (§2.4). With `opts.start_from_rest` the first step is
-/// a half step from standing; with `opts.stop` the last step is a half step that ends standing.
+/// a half step from standing; with `opts.stop` the last step is a half step, after which the
+/// trailing foot is brought alongside and the body comes to rest ([`stop`]).
 pub fn generate_walk(
     schedule: &[ScheduleEntry],
     opts: &WalkOptions,
