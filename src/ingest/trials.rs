@@ -593,6 +593,32 @@ impl Builder {
         }
     }
 
+    /// [`Builder::push`] for a parsed file's rows, after [`Builder::reserve`]: every column the
+    /// file has (`present`, the quantities' indices) already exists, so a row is one push per
+    /// column.
+    #[allow(clippy::too_many_arguments)]
+    fn push_parsed(
+        &mut self,
+        subject: &str,
+        gait: Option<Gait>,
+        side: Option<Side>,
+        source: &str,
+        trial: &str,
+        vals: &FieldValues,
+        present: &[usize],
+    ) {
+        self.subject.push(self.subjects.get(subject.as_bytes()));
+        self.source.push(self.sources.get(source.as_bytes()));
+        self.trial.push(self.trials.get(trial.as_bytes()));
+        self.gait.push(gait);
+        self.side.push(side);
+        for &q in present {
+            if let Some(c) = &mut self.columns[q] {
+                c.push(vals.0[q]);
+            }
+        }
+    }
+
     fn finish(self, path: PathBuf, sha256: String, ignored: Vec<String>) -> TrialsTable {
         let n = self.subject.len();
         TrialsTable {
@@ -622,8 +648,12 @@ impl Builder {
 /// Hex SHA-256 of `bytes`.
 pub fn sha256_hex(bytes: &[u8]) -> String {
     use sha2::{Digest, Sha256};
-    let d = Sha256::digest(bytes);
-    let mut s = String::with_capacity(64);
+    hex(&Sha256::digest(bytes))
+}
+
+/// Lower-case hex of a digest.
+fn hex(d: &[u8]) -> String {
+    let mut s = String::with_capacity(2 * d.len());
     for b in d {
         s.push_str(&format!("{b:02x}"));
     }
@@ -634,8 +664,43 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
 ///
 /// Errors name the file, the 1-based data row and the column, and say what would fix the input.
 pub fn read_trials(path: &Path) -> Result<TrialsTable, IngestError> {
-    let bytes = std::fs::read(path).map_err(|e| IngestError::io(path, e))?;
-    parse_trials(path, &bytes)
+    use std::io::Read;
+    // Streamed in blocks that are hashed and parsed while in cache: no buffer of the whole
+    // file (on a large table its page faults alone cost as much as the hashing).
+    let mut file = std::fs::File::open(path).map_err(|e| IngestError::io(path, e))?;
+    let len = file.metadata().map_or(0, |m| m.len()) as usize;
+    let mut head = Vec::with_capacity(FIRST_BLOCK.min(len + 1));
+    (&mut file)
+        .take(FIRST_BLOCK as u64)
+        .read_to_end(&mut head)
+        .map_err(|e| IngestError::io(path, e))?;
+    // Rows to reserve: the whole file's line count when it fits the first block, else the first
+    // block's lines scaled to the file's length (a hint: columns still grow past it).
+    let lines = memchr::memchr_iter(b'\n', &head).count();
+    let rows = if head.len() < FIRST_BLOCK {
+        lines
+    } else {
+        (lines as f64 * (len.max(head.len()) as f64 / head.len() as f64) * 1.02) as usize + 16
+    };
+    parse_from(path, std::io::Cursor::new(head).chain(file), rows)
+}
+
+/// The first block [`read_trials`] reads, to size the columns.
+const FIRST_BLOCK: usize = 1 << 16;
+
+/// A reader that hashes what passes through it.
+struct Hashing<R> {
+    inner: R,
+    hasher: sha2::Sha256,
+}
+
+impl<R: std::io::Read> std::io::Read for Hashing<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        use sha2::Digest;
+        let n = self.inner.read(buf)?;
+        self.hasher.update(&buf[..n]);
+        Ok(n)
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -651,12 +716,25 @@ enum Role {
 
 /// Parses trials CSV content; `path` is used for messages and provenance.
 pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestError> {
-    let sha = sha256_hex(bytes);
+    parse_from(path, bytes, memchr::memchr_iter(b'\n', bytes).count())
+}
+
+/// Parses trials CSV from `input` (hashed as it is read), with room for `rows` rows.
+fn parse_from(
+    path: &Path,
+    input: impl std::io::Read,
+    rows: usize,
+) -> Result<TrialsTable, IngestError> {
+    use sha2::Digest;
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(false)
         .trim(csv::Trim::None)
-        .from_reader(bytes);
+        .buffer_capacity(1 << 18)
+        .from_reader(Hashing {
+            inner: input,
+            hasher: sha2::Sha256::new(),
+        });
     let headers = rdr
         .byte_headers()
         .map_err(|e| IngestError::malformed(path, format!("cannot read the header line: {e}")))?
@@ -738,7 +816,8 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
     }
     let mut b = Builder::default();
     // One line per row: sizing the columns once saves their regrowth on large tables.
-    b.reserve(memchr::memchr_iter(b'\n', bytes).count(), &present);
+    b.reserve(rows, &present);
+    let present_idx: Vec<usize> = (0..N_QUANTITIES).filter(|&q| present[q]).collect();
     let extra_idx: Vec<usize> = (0..roles.len())
         .filter(|&k| matches!(roles[k], Role::Ignored))
         .collect();
@@ -749,6 +828,13 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
         match rdr.read_byte_record(&mut rec) {
             Ok(true) => {}
             Ok(false) => break,
+            Err(e) if e.is_io_error() => {
+                // Reading the file failed (the table is streamed): an I/O error, not bad CSV.
+                return Err(match e.into_kind() {
+                    csv::ErrorKind::Io(io) => IngestError::io(path, io),
+                    k => IngestError::malformed(path, format!("row {}: {k:?}", row + 1)),
+                });
+            }
             Err(e) => {
                 let what = match e.kind() {
                     csv::ErrorKind::UnequalLengths {
@@ -774,6 +860,11 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
                 Role::Subject => subject = cell,
                 Role::Source => source = cell,
                 Role::Trial => trial = cell,
+                // The spellings gaitfit writes, without the allocation of the general parse.
+                Role::Gait if cell == b"run" => gait = Some(Gait::Run),
+                Role::Gait if cell == b"walk" => gait = Some(Gait::Walk),
+                Role::Side if cell == b"left" => side = Some(Side::Left),
+                Role::Side if cell == b"right" => side = Some(Side::Right),
                 Role::Gait => {
                     if !cell.is_empty() {
                         let s = text(path, row, &headers[k], cell)?;
@@ -826,14 +917,14 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
         }
         let subject = std::str::from_utf8(subject)
             .map_err(|_| IngestError::cell(path, row, "subject", "not valid UTF-8"))?;
-        b.push(
+        b.push_parsed(
             subject,
             gait,
             side,
             &String::from_utf8_lossy(source),
             &String::from_utf8_lossy(trial),
             &vals,
-            &present,
+            &present_idx,
         );
     }
     if row == 0 {
@@ -842,6 +933,7 @@ pub fn parse_trials(path: &Path, bytes: &[u8]) -> Result<TrialsTable, IngestErro
             "no data rows after the header",
         ));
     }
+    let sha = hex(&rdr.into_inner().hasher.finalize());
     let mut t = b.finish(path.to_path_buf(), sha, ignored.clone());
     t.extra = ignored.into_iter().zip(extra).collect();
     // Columns the file has but all of whose cells are empty are still "present".
@@ -987,6 +1079,49 @@ mod tests {
 
     fn parse(s: &str) -> Result<TrialsTable, IngestError> {
         parse_trials(Path::new("t.csv"), s.as_bytes())
+    }
+
+    #[test]
+    fn a_streamed_file_reads_as_its_bytes_parse() {
+        // Larger than the first block (sizing from a sample), with mixed spellings of gait and
+        // side (the fast paths and the general parse), and a small file read whole.
+        let mut text = String::from(
+            "subject,gait,side,speed_m_per_s,step_length_m,step_freq_steps_per_min,weight\n",
+        );
+        let mut k = 0usize;
+        while text.len() < 3 * FIRST_BLOCK + 17 {
+            let gait = ["run", "walk", "Running", " walk "][k % 4];
+            let side = ["left", "r", "", "right"][k % 4];
+            let sl = 0.6 + 0.001 * (k % 500) as f64;
+            let sf = 150.0 + (k % 37) as f64;
+            let w = if k % 5 == 0 {
+                "x".to_string()
+            } else {
+                k.to_string()
+            };
+            text.push_str(&format!(
+                "s{},{gait},{side},{},{sl},{sf},{w}\n",
+                k % 11,
+                sl * sf / 60.0
+            ));
+            k += 1;
+        }
+        let dir = tempfile::tempdir().unwrap();
+        for t in [&text[..], &text[..300]] {
+            let t = &t[..t.rfind('\n').unwrap() + 1];
+            let p = dir.path().join("big.csv");
+            std::fs::write(&p, t).unwrap();
+            let read = read_trials(&p).unwrap();
+            let parsed = parse_trials(&p, t.as_bytes()).unwrap();
+            assert_eq!(read.sha256, sha256_hex(t.as_bytes()));
+            // Debug text: NaN cells (the non-numeric `weight`s) compare equal.
+            assert_eq!(format!("{read:?}"), format!("{parsed:?}"));
+            assert_eq!(read.len(), t.lines().count() - 1);
+        }
+        assert!(matches!(
+            read_trials(&dir.path().join("missing.csv")),
+            Err(IngestError::Io { .. })
+        ));
     }
 
     #[test]
