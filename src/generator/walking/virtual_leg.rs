@@ -494,3 +494,130 @@ impl VirtualLeg {
         p
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::body::Body;
+    use super::*;
+
+    fn leg(body: &Body, period: FootPeriod, rho: f64) -> VirtualLeg {
+        VirtualLeg {
+            foot: FootShape::new(body),
+            l3: body.l3,
+            l4: body.l4,
+            flat_ankle: [0.0, body.l9],
+            theta5_max: 100f64.to_radians(),
+            theta6_max: 30f64.to_radians(),
+            knee_toe_off: 35f64.to_radians(),
+            toe_off_time: 1.0,
+            min_knee_blend: 0.0,
+            period,
+            rho,
+            meta_start: None,
+            transitions: [None; 3],
+            rocker: None,
+        }
+    }
+
+    /// A hip that lands behind the foot with the straight leg reaching the pitched ankle, then
+    /// moves forward and down (as KLAW's does after the collision): the flat foot comes within
+    /// reach after a few milliseconds.
+    fn hip_path(body: &Body, pitch: f64) -> Vec<(f64, [f64; 2], f64)> {
+        let l = leg(body, FootPeriod::HeelRocker, -pitch);
+        let (ankle, _, _) = l.foot.rolled(l.flat_ankle, -pitch, l.theta6_max);
+        let a = 22f64.to_radians();
+        let l1 = body.l3 + body.l4;
+        let hip0 = [ankle[0] - l1 * a.sin(), ankle[1] + l1 * a.cos()];
+        (0..=250)
+            .map(|i| {
+                let t = 0.002 * i as f64;
+                let drop = 0.03 * (1.0 - (-t / 0.05).exp());
+                (t, [hip0[0] + 1.3 * t, hip0[1] - drop], 0.0)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn planned_heel_rocker_stays_in_reach_and_lands_flat_at_rest() {
+        let body = Body::from_height(1.8, 75.0).unwrap();
+        let pitch = 0.35;
+        let hips = hip_path(&body, pitch);
+        let l1 = body.l3 + body.l4;
+        // The straight-leg rule: the foot slaps down and the knee snaps.
+        let mut rule = leg(&body, FootPeriod::HeelRocker, -pitch);
+        let rule_poses: Vec<LegPose> = hips.iter().map(|h| rule.advance(h.0, h.1, h.2)).collect();
+        let flat_rule = rule.transitions[0].unwrap();
+        let mut planned = leg(&body, FootPeriod::HeelRocker, -pitch);
+        assert!(planned.plan_heel_rocker(&hips, 0.08));
+        let end = planned.rocker.as_ref().unwrap().end;
+        assert!(end >= 0.08 && end > flat_rule, "{end} {flat_rule}");
+        let poses: Vec<LegPose> = hips
+            .iter()
+            .map(|h| planned.advance(h.0, h.1, h.2))
+            .collect();
+        assert_eq!(planned.transitions[0], Some(end));
+        let mut prev_rho = -pitch;
+        let mut max_dk: f64 = 0.0;
+        let mut max_drho: f64 = 0.0;
+        for (h, p) in hips.iter().zip(&poses) {
+            // Within reach of the leg, the roll never decreasing.
+            let d = (h.1[0] - p.ankle[0]).hypot(h.1[1] - p.ankle[1]);
+            assert!(d <= l1 + 1e-9, "out of reach by {} at t = {}", d - l1, h.0);
+            assert!(p.rho >= prev_rho - 1e-12);
+            if h.0 <= end {
+                max_drho = max_drho.max(p.rho - prev_rho);
+            }
+            prev_rho = p.rho;
+        }
+        for w in poses.windows(2) {
+            max_dk = max_dk.max((w[1].knee - w[0].knee).abs());
+        }
+        // The roll arrives at 0 at rest: the last increment before flat is a small fraction of
+        // the largest.
+        let k_end = hips.iter().position(|h| h.0 >= end).unwrap();
+        let last_inc = poses[k_end].rho - poses[k_end - 1].rho;
+        assert!(last_inc <= 0.05 * max_drho, "{last_inc} vs {max_drho}");
+        // The knee flexes without the rule's snap: its largest 2 ms change is well below the
+        // straight-leg rule's.
+        let max_dk_rule = rule_poses
+            .windows(2)
+            .map(|w| (w[1].knee - w[0].knee).abs())
+            .fold(0.0, f64::max);
+        assert!(max_dk < 0.5 * max_dk_rule, "{max_dk} vs rule {max_dk_rule}");
+    }
+
+    #[test]
+    fn smoothed_roll_is_never_below_the_rule_and_keeps_its_ends() {
+        // Flat until 0.1 s, a 0.02 rad rise in 8 ms (the rule's heel-off kick), then a creep.
+        let times: Vec<f64> = (0..=200).map(|i| 0.002 * i as f64).collect();
+        let rule: Vec<f64> = times
+            .iter()
+            .map(|&t| {
+                if t < 0.1 {
+                    0.0
+                } else if t < 0.108 {
+                    0.02 * (t - 0.1) / 0.008
+                } else {
+                    0.02 + 0.1 * (t - 0.108)
+                }
+            })
+            .collect();
+        let mut s = rule.clone();
+        smooth_roll(&times, &mut s, 0, 0.05, 2);
+        assert_eq!(s[0], rule[0]);
+        assert_eq!(s[200], rule[200]);
+        for i in 0..=200 {
+            assert!(s[i] >= rule[i] - 1e-12, "below the rule at {i}");
+            if i > 0 {
+                assert!(s[i] >= s[i - 1] - 1e-12, "decreasing at {i}");
+            }
+        }
+        let max_inc = |v: &[f64]| v.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+        assert!(
+            max_inc(&s) < 0.25 * max_inc(&rule),
+            "{} vs {}",
+            max_inc(&s),
+            max_inc(&rule)
+        );
+    }
+}
