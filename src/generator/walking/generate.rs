@@ -369,6 +369,7 @@ pub fn generate_steps(
         meta_start: None,
         transitions: [None; 3],
         rocker: None,
+        knee_soft: super::virtual_leg::KNEE_SOFT,
     };
     let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
     let mut trailing_clock = 0.0;

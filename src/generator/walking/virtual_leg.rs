@@ -23,7 +23,7 @@ use super::foot::{smoothstep, FootShape};
 use std::f64::consts::FRAC_PI_2;
 
 /// Width of the knee's soft straightening in late stance, m.
-const KNEE_SOFT: f64 = 0.0015;
+pub const KNEE_SOFT: f64 = 0.0015;
 
 /// How far the foot may roll about the toe tip beyond the toe-bend limit, rad (80°).
 const RHO_CAP: f64 = 1.4;
@@ -98,6 +98,9 @@ pub struct VirtualLeg {
     /// The planned heel rocker (see [`VirtualLeg::plan_heel_rocker`]); `None`: the foot
     /// lowers as fast as the straight leg allows.
     pub rocker: Option<HeelRocker>,
+    /// Width of the knee's soft straightening in late stance, m (see [`KNEE_SOFT`]; narrower
+    /// when a planned heel rocker lands with the knee nearly straight).
+    pub knee_soft: f64,
 }
 
 /// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
@@ -314,6 +317,37 @@ impl VirtualLeg {
         if self.period != FootPeriod::HeelRocker || self.rho >= 0.0 || samples.len() < 3 {
             return false;
         }
+        let d_flat: Vec<f64> = samples
+            .iter()
+            .map(|&(_, hip, dz)| {
+                let p = self.pose_at(hip, dz, 0.0);
+                let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+                (hip[0] - p.ankle[0]).hypot(dy)
+            })
+            .collect();
+        // First the flat period's own soft leg length; failing that (slow walks, whose hip
+        // never comes lower than about the straight leg: the foot is flat only in passing), any
+        // landing within reach by 0.3 mm, as early as 0.3 × `min_duration`, the knee's soft
+        // straightening then narrowed so the flat foot does not roll forward the moment it lands.
+        let min_soft = 0.00015;
+        for (soft, shortest) in [
+            (self.knee_soft, min_duration),
+            (min_soft, 0.3 * min_duration),
+        ] {
+            if self.plan_with(samples, shortest, soft, &d_flat) {
+                return true;
+            }
+        }
+        false
+    }
+
+    fn plan_with(
+        &mut self,
+        samples: &[(f64, [f64; 2], f64)],
+        min_duration: f64,
+        soft: f64,
+        d_flat: &[f64],
+    ) -> bool {
         let (l3, l4) = (self.l3, self.l4);
         let l1 = l3 + l4;
         let pitch = -self.rho;
@@ -322,11 +356,7 @@ impl VirtualLeg {
             let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
             (hip[0] - p.ankle[0]).hypot(dy)
         };
-        let d_flat: Vec<f64> = samples
-            .iter()
-            .map(|&(_, hip, dz)| dist(0.0, hip, dz))
-            .collect();
-        let a0 = l1 - 2.0 * KNEE_SOFT;
+        let a0 = l1 - 2.0 * soft;
         let t_first = samples[0].0;
         let mut duration = min_duration;
         for _ in 0..30 {
@@ -356,7 +386,7 @@ impl VirtualLeg {
                 .iter()
                 .map(|f| f * k_end / big_t)
                 .find(|&r0| {
-                    samples[..kt].iter().zip(&d_flat).all(|(&(t, _, _), &df)| {
+                    samples[..kt].iter().zip(d_flat).all(|(&(t, _, _), &df)| {
                         knee_at(t, r0) >= knee_for(l3, l4, df.min(l1)) - 1e-6
                     })
                 })
@@ -380,6 +410,8 @@ impl VirtualLeg {
                 table.push((t, last));
             }
             self.rocker = Some(HeelRocker { end, table });
+            let landing = d_flat[kt - 1].max(d_flat[kt]).max(d_flat[kt + 1]);
+            self.knee_soft = self.knee_soft.min(soft.max(0.5 * (l1 - landing)));
             return true;
         }
         false
@@ -436,7 +468,7 @@ impl VirtualLeg {
                 let p = self.pose_at(hip, dz, 0.0);
                 reach(&p, hip) + l1
             };
-            let sigma = KNEE_SOFT;
+            let sigma = self.knee_soft;
             let a0 = l1 - 2.0 * sigma;
             let d_t = if d_flat <= a0 {
                 d_flat
@@ -516,6 +548,7 @@ mod tests {
             meta_start: None,
             transitions: [None; 3],
             rocker: None,
+            knee_soft: KNEE_SOFT,
         }
     }
 
