@@ -621,39 +621,62 @@ pub fn ols(p: &LinearProblem) -> Result<LinearFit, FitError> {
     let x = p.x;
     let col = |j: usize| &x.as_slice()[j * n..(j + 1) * n];
     let y = p.y.as_slice();
-    // Fitted values (centred basis), residuals, and leverages h_ii = ‖R⁻ᵀ a_i‖², column by
-    // column so every pass is a contiguous, vectorisable loop.
-    let mut fitted = vec![0.0; n];
-    for j in 0..k {
-        let (mj, bj) = (means[j], centred[j]);
-        for (f, v) in fitted.iter_mut().zip(col(j)) {
-            *f += (v - mj) * bj;
-        }
-    }
-    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
-    let rss: f64 = residuals.iter().zip(&wv).map(|(e, w)| w * e * e).sum();
-    // Row by row (k small): the k column streams are read in step, no scratch vectors.
-    let mut leverage = vec![0.0; n];
+    // Fitted values (centred basis) and leverages h_ii = ‖R⁻ᵀ a_i‖² in one pass over blocks of
+    // rows: each block's centred columns are formed once, and every inner loop runs along the
+    // rows (contiguous, vectorised). Sums are taken in the same order as row by row.
     let g: Vec<f64> = (0..k * k)
         .map(|idx| {
             let (l, jj) = (idx % k, idx / k);
             rinv[(l, jj)] / scales[l]
         })
         .collect();
-    let cols: Vec<&[f64]> = (0..k).map(col).collect();
-    let mut d = vec![0.0; k];
-    for (i, h) in leverage.iter_mut().enumerate() {
+    let mut fitted = vec![0.0; n];
+    let mut leverage = vec![0.0; n];
+    const B: usize = 256;
+    let mut d = vec![0.0; k * B];
+    let (mut u, mut acc) = ([0.0f64; B], [0.0f64; B]);
+    let mut start = 0;
+    while start < n {
+        let m = B.min(n - start);
         for l in 0..k {
-            d[l] = cols[l][i] - means[l];
+            let ml = means[l];
+            let dl = &mut d[l * B..l * B + m];
+            for (dv, v) in dl.iter_mut().zip(&col(l)[start..start + m]) {
+                *dv = v - ml;
+            }
         }
-        let mut acc = 0.0;
+        let f = &mut fitted[start..start + m];
+        for j in 0..k {
+            let bj = centred[j];
+            for (f, dv) in f.iter_mut().zip(&d[j * B..j * B + m]) {
+                *f += dv * bj;
+            }
+        }
+        acc[..m].fill(0.0);
         for jj in 0..k {
-            let gj = &g[jj * k..jj * k + jj + 1];
-            let u: f64 = gj.iter().zip(&d).map(|(a, b)| a * b).sum();
-            acc += u * u;
+            // −0.0: the start of `Iterator::sum`, which the row-by-row form used.
+            u[..m].fill(-0.0);
+            for l in 0..=jj {
+                let gl = g[jj * k + l];
+                for (uv, dv) in u[..m].iter_mut().zip(&d[l * B..l * B + m]) {
+                    *uv += gl * dv;
+                }
+            }
+            for (a, uv) in acc[..m].iter_mut().zip(&u[..m]) {
+                *a += uv * uv;
+            }
         }
-        *h = acc * wv[i];
+        for ((h, a), w) in leverage[start..start + m]
+            .iter_mut()
+            .zip(&acc[..m])
+            .zip(&wv[start..start + m])
+        {
+            *h = a * w;
+        }
+        start += m;
     }
+    let residuals: Vec<f64> = y.iter().zip(&fitted).map(|(y, f)| y - f).collect();
+    let rss: f64 = residuals.iter().zip(&wv).map(|(e, w)| w * e * e).sum();
 
     let df = n - k;
     let sigma2 = rss / df as f64;
