@@ -445,9 +445,9 @@ impl VirtualLeg {
                 self.transitions[0] = Some(t);
             } else {
                 let a = -1.2;
-                if g(a) > 0.0 {
-                    self.rho = a;
-                } else {
+                // Out of reach even steeply pitched: hold the roll (pitching the foot up to
+                // the bound, 69°, and snapping it down later is no help to the leg).
+                if g(a) <= 0.0 {
                     self.rho = root_nonpositive_side(&g, 0.0, a).max(self.rho);
                 }
                 let mut p = self.pose_at(hip, dz, self.rho);
