@@ -126,6 +126,44 @@ fn accelerating_and_decelerating_from_standing_to_stop() {
     let p0 = m.landmark(0, Landmark::Pelvis);
     let p1 = m.landmark(1, Landmark::Pelvis);
     assert!((p1 - p0).length() * m.fps() < 0.3, "start speed");
+    // No stance-foot point jumps: a stance leg that could not reach its foot used to pitch it
+    // to the heel rocker's 69° bound and snap it flat once in reach (toe 33 cm in one frame
+    // after the first step). A rolling stance foot moves at most ≈ 1 m/s; 5 cm per frame is 5 m/s.
+    let feet = [
+        (
+            Side::Left,
+            [
+                Landmark::LAnkle,
+                Landmark::LHeel,
+                Landmark::LBall,
+                Landmark::LToe,
+            ],
+        ),
+        (
+            Side::Right,
+            [
+                Landmark::RAnkle,
+                Landmark::RHeel,
+                Landmark::RBall,
+                Landmark::RToe,
+            ],
+        ),
+    ];
+    for (side, points) in feet {
+        for i in 1..m.len() {
+            if !(m.contact(i - 1, side) && m.contact(i, side)) {
+                continue;
+            }
+            for l in points {
+                let step = (m.landmark(i, l) - m.landmark(i - 1, l)).length();
+                assert!(
+                    step < 0.05,
+                    "stance {l:?} moves {step:.3} m between frames {} and {i}",
+                    i - 1
+                );
+            }
+        }
+    }
 }
 
 #[test]
