@@ -379,7 +379,8 @@ pub fn generate_steps(
         trailing.period = FootPeriod::HeelOff;
     }
     let mut stance_guess = [0.0, 0.0];
-    let mut swing_guess = [0.0, 0.0, 0.0, 0.0];
+    let mut swing_guess = [0.0; 5];
+    let mut recovery_by_leg = [0.0f64; 2];
     let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
         .chain(steps.iter().copied())
         .collect();
@@ -558,10 +559,14 @@ pub fn generate_steps(
             theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
             max_step: a.max_step_s,
         };
+        // The swing2 recovery's actuator is carried over from the same leg's last swing: fast
+        // walks alternate between legs (period-two pattern of the recovery).
+        swing_guess[4] = recovery_by_leg[idx(swing_side)];
         let sw = sspec
             .solve(&swing_start, swing_guess, l.speed_m_per_s)
             .map_err(|e| num_err(stage("swing shooting"), e))?;
         swing_guess = sw.params;
+        recovery_by_leg[idx(swing_side)] = sw.params[4];
         if std::env::var("KLAW_DUMP").is_ok() {
             eprintln!("p0 {:?}", p0);
             eprintln!(

@@ -211,9 +211,9 @@ pub struct SwingRun {
     pub track: Track<2>,
     /// Shooting iterations of swing1, swing2 (all recovery rounds), swing3.
     pub iterations: [usize; 3],
-    /// Torque parameters `A`, `B`, `C` found, and the swing1 recovery's lift of the ankle
-    /// curve (m).
-    pub params: [f64; 4],
+    /// Torque parameters `A`, `B`, `C` found, the swing1 recovery's lift of the ankle curve (m)
+    /// and the swing2 recovery's position actuator (rad); the next step starts from them.
+    pub params: [f64; 5],
     /// Final position actuator of the stubbing recovery, rad (0 if not needed).
     pub recovery: f64,
     /// Recovery rounds used.
@@ -227,6 +227,12 @@ pub struct SwingRun {
 }
 
 const TOL: f64 = 1e-8;
+
+/// Increment of the swing2 recovery's position actuator, rad.
+const RECOVERY_STEP: f64 = 0.02;
+
+/// Largest number of recovery increments.
+const RECOVERY_MAX: usize = 20;
 
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
@@ -546,7 +552,7 @@ impl SwingSpec<'_> {
     pub fn solve(
         &self,
         start: &SwingStart,
-        guess: [f64; 4],
+        guess: [f64; 5],
         speed: f64,
     ) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
@@ -617,12 +623,20 @@ impl SwingSpec<'_> {
         };
         let last = *track.nodes.last().ok_or("swing1 recorded nothing")?;
         let y2_0 = [y1[0], last.q[1], y1[1], last.qd[1]];
-        // swing2 with the ground-stubbing recovery.
-        let mut pa = 0.0;
-        let mut rounds = 0;
+        // swing2 with the ground-stubbing recovery: the least position actuator on the grid
+        // k·RECOVERY_STEP (k ≤ RECOVERY_MAX) for which the foot clears the ground. The search
+        // starts one grid step below the previous step's actuator (carried over like the force
+        // profiles): a steady walk then needs two swing2 solves instead of k + 1 (slow walks
+        // needed ≈ 35 simulations per step for k = 6).
+        let k_prev = (guess[4].max(0.0) / RECOVERY_STEP).round() as usize;
+        let mut k = k_prev.saturating_sub(1).min(RECOVERY_MAX);
         let mut it2 = 0;
         let mut b_guess = guess[1];
-        let (s2, lowest) = loop {
+        let mut going_down = false;
+        let mut first = true;
+        let mut best = None;
+        let (s2, lowest, rounds) = loop {
+            let pa = k as f64 * RECOVERY_STEP;
             let s2 = solve_1d(
                 |b| self.swing2(y2_0, b, pa, h, None).0[1],
                 b_guess,
@@ -633,13 +647,30 @@ impl SwingSpec<'_> {
             .map_err(|e| format!("swing2: {e}"))?;
             it2 += s2.iterations;
             let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
-            if lowest >= self.clearance || rounds >= 20 {
-                break (s2, lowest);
-            }
-            rounds += 1;
-            pa += 0.02;
             b_guess = s2.x[0];
+            let was_first = std::mem::replace(&mut first, false);
+            if lowest >= self.clearance {
+                // Clear: the least clear k is below if the search has not come up from there.
+                best = Some((s2, lowest, k));
+                if k > 0 && (going_down || was_first) {
+                    going_down = true;
+                    k -= 1;
+                    continue;
+                }
+                break (s2, lowest, k);
+            }
+            if going_down {
+                // k fails and k + 1 cleared.
+                if let Some(b) = best {
+                    break b;
+                }
+            }
+            if k >= RECOVERY_MAX {
+                break (s2, lowest, k);
+            }
+            k += 1;
         };
+        let pa = rounds as f64 * RECOVERY_STEP;
         let before = track.nodes.len();
         let (y2, _) = self.swing2(y2_0, s2.x[0], pa, h, Some(&mut track));
         let _ = before;
@@ -668,7 +699,7 @@ impl SwingSpec<'_> {
         let _ = lowest;
         Ok(SwingRun {
             iterations: [it1, it2, s3.iterations],
-            params: [a1, s2.x[0], s3.x[0], extra],
+            params: [a1, s2.x[0], s3.x[0], extra, pa],
             recovery: pa,
             recovery_rounds: rounds + lift_rounds,
             min_clearance,
