@@ -327,12 +327,14 @@ impl VirtualLeg {
             .collect();
         // First the flat period's own soft leg length; failing that (slow walks, whose hip
         // never comes lower than about the straight leg: the foot is flat only in passing), any
-        // landing within reach by 0.3 mm, as early as 0.3 × `min_duration`, the knee's soft
-        // straightening then narrowed so the flat foot does not roll forward the moment it lands.
+        // landing within reach by 0.3 mm (then 0.03 mm), as early as 0.3 × `min_duration`, the
+        // knee's soft straightening then narrowed so the flat foot does not roll forward the
+        // moment it lands.
         let min_soft = 0.00015;
         for (soft, shortest) in [
             (self.knee_soft, min_duration),
             (min_soft, 0.3 * min_duration),
+            (0.1 * min_soft, 0.3 * min_duration),
         ] {
             if self.plan_with(samples, shortest, soft, &d_flat) {
                 return true;
