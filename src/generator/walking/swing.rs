@@ -231,8 +231,10 @@ const TOL: f64 = 1e-8;
 /// Increment of the swing2 recovery's position actuator, rad.
 const RECOVERY_STEP: f64 = 0.02;
 
-/// Largest number of recovery increments.
-const RECOVERY_MAX: usize = 20;
+/// Largest number of recovery increments (0.8 rad of set-point shift). The soft swing2 hip
+/// spring lifts the foot only ≈ 1 mm per increment in fast walks of short bodies (7 km/h at
+/// 1.5 m needs ≈ 25); 20 left the heel up to 4 mm in the ground there.
+const RECOVERY_MAX: usize = 40;
 
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
@@ -627,14 +629,18 @@ impl SwingSpec<'_> {
         // k·RECOVERY_STEP (k ≤ RECOVERY_MAX) for which the foot clears the ground. The search
         // starts one grid step below the previous step's actuator (carried over like the force
         // profiles): a steady walk then needs two swing2 solves instead of k + 1 (slow walks
-        // needed ≈ 35 simulations per step for k = 6).
+        // needed ≈ 35 simulations per step for k = 6). Going up, the clearance is close to
+        // linear in k (≈ 1 mm per grid step at 7 km/h, h 1.5 m), so the next k is extrapolated
+        // from the last two failing ones (at least one step up); a k reached by a jump is then
+        // walked down until the grid step below it fails, so the result is still the least
+        // clear k when clearance grows with the actuator.
         let k_prev = (guess[4].max(0.0) / RECOVERY_STEP).round() as usize;
         let mut k = k_prev.saturating_sub(1).min(RECOVERY_MAX);
         let mut it2 = 0;
         let mut b_guess = guess[1];
-        let mut going_down = false;
-        let mut first = true;
-        let mut best = None;
+        // Largest failing k and its clearance; least clear k and its solve.
+        let mut fail_hi: Option<(usize, f64)> = None;
+        let mut clear_lo = None;
         let (s2, lowest, rounds) = loop {
             let pa = k as f64 * RECOVERY_STEP;
             let s2 = solve_1d(
@@ -648,27 +654,37 @@ impl SwingSpec<'_> {
             it2 += s2.iterations;
             let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
             b_guess = s2.x[0];
-            let was_first = std::mem::replace(&mut first, false);
             if lowest >= self.clearance {
-                // Clear: the least clear k is below if the search has not come up from there.
-                best = Some((s2, lowest, k));
-                if k > 0 && (going_down || was_first) {
-                    going_down = true;
-                    k -= 1;
-                    continue;
+                clear_lo = Some((s2, lowest, k));
+                let below_fails = fail_hi.is_some_and(|(kf, _)| kf + 1 == k);
+                if k == 0 || below_fails {
+                    break (s2, lowest, k);
                 }
-                break (s2, lowest, k);
+                k -= 1;
+                continue;
             }
-            if going_down {
-                // k fails and k + 1 cleared.
-                if let Some(b) = best {
-                    break b;
+            let prev = fail_hi.filter(|&(kf, _)| kf < k);
+            fail_hi = Some((k, lowest));
+            if let Some(c) = clear_lo {
+                if c.2 == k + 1 {
+                    break c;
                 }
             }
             if k >= RECOVERY_MAX {
                 break (s2, lowest, k);
             }
-            k += 1;
+            let mut next = k + 1;
+            if let Some((kp, lp)) = prev {
+                let slope = (lowest - lp) / (k - kp) as f64;
+                if slope > 0.0 {
+                    let need = ((self.clearance - lowest) / slope).ceil();
+                    if need.is_finite() && need > 1.0 {
+                        next = k + (need as usize).min(RECOVERY_MAX);
+                    }
+                }
+            }
+            let cap = clear_lo.map_or(RECOVERY_MAX, |c| c.2 - 1);
+            k = next.min(cap).min(RECOVERY_MAX).max(k + 1);
         };
         let pa = rounds as f64 * RECOVERY_STEP;
         let before = track.nodes.len();
