@@ -239,6 +239,13 @@ const RECOVERY_MAX: usize = 40;
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
 
+/// Largest ankle lift of swing1's curve per metre of the ankle's travel `D`. Not in the paper
+/// (its lift is fixed): in a short half step (the last one of a slow stop, D ≈ 16 cm) the slow
+/// walk's 7 cm lift made the curve fall about along the circle the ankle can reach about the
+/// knee, and the slaved knee slid the ankle 10 cm along it in 11 ms. Steady walks' D is long
+/// enough that this binds only marginally (1 km/h).
+const LIFT_PER_TRAVEL: f64 = 0.25;
+
 impl SwingSpec<'_> {
     /// The kinematic swing foot of this swing.
     pub fn swing_foot(&self) -> SwingFoot {
@@ -360,7 +367,7 @@ impl SwingSpec<'_> {
             ));
         }
         let a_min = a1[1] + extra_lift;
-        let lift = self.ankle_lift / speed.max(0.5);
+        let lift = (self.ankle_lift / speed.max(0.5)).min(LIFT_PER_TRAVEL * d);
         let a_max = a0[1].max(a_min) + lift;
         AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
             .ok_or_else(|| "ankle curve is singular".to_string())
