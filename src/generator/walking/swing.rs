@@ -648,6 +648,7 @@ impl SwingSpec<'_> {
         // Largest failing k and its clearance; least clear k and its solve.
         let mut fail_hi: Option<(usize, f64)> = None;
         let mut clear_lo = None;
+        let mut best_fail = None;
         let (s2, lowest, rounds) = loop {
             let pa = k as f64 * RECOVERY_STEP;
             let s2 = solve_1d(
@@ -672,13 +673,22 @@ impl SwingSpec<'_> {
             }
             let prev = fail_hi.filter(|&(kf, _)| kf < k);
             fail_hi = Some((k, lowest));
+            if best_fail
+                .as_ref()
+                .is_none_or(|b: &(_, f64, usize)| lowest > b.1)
+            {
+                best_fail = Some((s2, lowest, k));
+            }
             if let Some(c) = clear_lo {
                 if c.2 == k + 1 {
                     break c;
                 }
             }
             if k >= RECOVERY_MAX {
-                break (s2, lowest, k);
+                // Nothing on the grid clears (the first half step from rest, where the dip
+                // comes at swing2's start, before the actuator acts): the clearest one tried.
+                // Clearance is then not monotone in k, so the cap itself can be worse.
+                break best_fail.unwrap_or((s2, lowest, k));
             }
             let mut next = k + 1;
             if let Some((kp, lp)) = prev {
