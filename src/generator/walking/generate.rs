@@ -567,16 +567,6 @@ pub fn generate_steps(
             .map_err(|e| num_err(stage("swing shooting"), e))?;
         swing_guess = sw.params;
         recovery_by_leg[idx(swing_side)] = sw.params[4];
-        if std::env::var("KLAW_DUMP").is_ok() {
-            eprintln!("p0 {:?}", p0);
-            eprintln!(
-                "step {k}: start {:?} curve {:?} th3_hs {:.2}\n{}",
-                swing_start,
-                sw.curve,
-                hs.theta3.to_degrees(),
-                sw.dump(&sspec, 15)
-            );
-        }
         // 5. Heel strike.
         let last = *sw
             .track

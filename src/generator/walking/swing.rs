@@ -614,15 +614,6 @@ impl SwingSpec<'_> {
                 };
                 deficit = deficit.max(need - low);
             }
-            if std::env::var("KLAW_DUMP2").is_ok() {
-                let worst = track
-                    .nodes
-                    .iter()
-                    .filter(|n| n.t > t0)
-                    .map(|n| (n.t, self.foot_points(n.t, &n.q)))
-                    .min_by(|a, b| a.1.lowest().total_cmp(&b.1.lowest()));
-                eprintln!("round {lift_rounds} extra {extra:.4} deficit {deficit:.5} worst {:?} t0 {t0} t1 {t1}", worst);
-            }
             if deficit <= 0.0 || lift_rounds >= 10 {
                 break (s1.x[0], curve, track, y1);
             }
