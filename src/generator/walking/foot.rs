@@ -69,21 +69,44 @@ impl FootShape {
     /// joint fixed); `ρ > θ6max` toe rocker (meta-off: pitch `−ρ`, `θ6 = θ6max`, toe tip fixed).
     /// `flat_ankle` is the ankle's position when the foot is flat. Returns the ankle position,
     /// the pitch and the toe bend.
+    ///
+    /// The paper switches from the forefoot to the toe rocker at `θ6 = θ6max`, where the toe
+    /// bend stops dead (its rate drops from the roll rate to 0 in one instant: a one-frame jump
+    /// of the metatarsal joint's motion). Here the toe segment's lift off the ground, `ψ = ρ −
+    /// θ6`, is the C¹ ramp [`toe_lift`] of `ρ − θ6max` over `±δ`: `θ6` reaches `θ6max` with zero
+    /// rate, never exceeds it, and the toe tip stays the fixed pivot throughout (for `ψ = 0`
+    /// the toe-pivot formula is the forefoot rocker's, so both rockers are one formula).
     pub fn rolled(&self, flat_ankle: [f64; 2], rho: f64, theta6_max: f64) -> ([f64; 2], f64, f64) {
         if rho <= 0.0 {
             let heel_g = add(flat_ankle, self.heel);
             let phi = -rho;
             (sub(heel_g, rot(phi, self.heel)), phi, 0.0)
-        } else if rho <= theta6_max {
-            let mtp_g = add(flat_ankle, self.mtp);
-            let phi = -rho;
-            (sub(mtp_g, rot(phi, self.mtp)), phi, rho)
         } else {
             let toe_g = add(flat_ankle, self.toe);
             let phi = -rho;
-            let toe_rel = add(self.mtp, rot(theta6_max, sub(self.toe, self.mtp)));
-            (sub(toe_g, rot(phi, toe_rel)), phi, theta6_max)
+            let theta6 = rho - toe_lift(rho - theta6_max, toe_blend(theta6_max));
+            let toe_rel = add(self.mtp, rot(theta6, sub(self.toe, self.mtp)));
+            (sub(toe_g, rot(phi, toe_rel)), phi, theta6)
         }
+    }
+}
+
+/// Half-width `δ` of the forefoot → toe rocker blend, rad: 0.15 rad, at most half of `θ6max`.
+#[inline]
+pub fn toe_blend(theta6_max: f64) -> f64 {
+    (0.5 * theta6_max).min(0.15)
+}
+
+/// The toe segment's lift `ψ(x)` for `x = ρ − θ6max`: 0 for `x ≤ −δ`, `x` for `x ≥ δ`, the C¹
+/// quadratic `(x + δ)² / 4δ` between — always `≥ max(0, x)`, so `θ6 = ρ − ψ ≤ θ6max`.
+#[inline]
+pub fn toe_lift(x: f64, delta: f64) -> f64 {
+    if x <= -delta {
+        0.0
+    } else if x >= delta {
+        x
+    } else {
+        (x + delta).powi(2) / (4.0 * delta)
     }
 }
 
@@ -138,13 +161,34 @@ mod tests {
             let fp = f.points(flat, 0.0, 0.0);
             if rho <= 0.0 {
                 assert!((p.heel[0] - fp.heel[0]).abs() < 1e-12 && p.heel[1].abs() < 1e-12);
-            } else if rho <= m {
+            } else if rho <= m - toe_blend(m) {
                 assert!((p.toe[0] - fp.toe[0]).abs() < 1e-12 && p.toe[1].abs() < 1e-12);
                 assert!(p.ball[1].abs() < 1e-12);
+                assert!((t6 - rho).abs() < 1e-12);
             } else {
+                assert!(t6 <= m + 1e-12 && t6 >= m - toe_blend(m) - 1e-12);
                 assert!((p.toe[0] - fp.toe[0]).abs() < 1e-12 && p.toe[1].abs() < 1e-12);
             }
             assert!(p.lowest() > -1e-12);
         }
+    }
+
+    #[test]
+    fn toe_bend_reaches_its_limit_with_zero_rate() {
+        // C¹: the toe bend's rate dθ6/dρ goes from 1 to 0 through the blend without a jump.
+        let b = Body::from_height(1.8, 80.0).unwrap();
+        let f = FootShape::new(&b);
+        let m = 0.5;
+        let h = 1e-4;
+        let t6 = |rho: f64| f.rolled([0.3, b.l9], rho, m).2;
+        let mut prev_rate = 1.0;
+        for k in 1..2000 {
+            let rho = k as f64 * 5e-4;
+            let rate = (t6(rho + h) - t6(rho - h)) / (2.0 * h);
+            assert!((rate - prev_rate).abs() < 0.01, "rate jumps at ρ = {rho}");
+            assert!((-1e-9..=1.0 + 1e-9).contains(&rate));
+            prev_rate = rate;
+        }
+        assert!(prev_rate.abs() < 1e-9 && (t6(0.99) - m).abs() < 1e-12);
     }
 }

@@ -19,7 +19,7 @@
 //! ([`FootShape::rolled`]); `ρ` never decreases after the foot is flat. Distances are measured in
 //! three dimensions (the hip's lateral offset from the foot, `dz`, is included), so the leg drawn
 //! in 3D reaches its ankle exactly.
-use super::foot::{smoothstep, FootShape};
+use super::foot::{smoothstep, toe_blend, FootShape};
 use std::f64::consts::FRAC_PI_2;
 
 /// Width of the knee's soft straightening in late stance, m.
@@ -488,7 +488,10 @@ impl VirtualLeg {
                 self.period = FootPeriod::HeelOff;
                 self.transitions[1] = Some(t);
             }
-            if rho <= self.theta6_max {
+            // Meta-off begins where the ball leaves the ground: the start of the forefoot → toe
+            // rocker blend of `FootShape::rolled`, δ before the toe bend's limit.
+            let meta_off_rho = self.theta6_max - toe_blend(self.theta6_max);
+            if rho <= meta_off_rho {
                 self.rho = rho;
                 let mut p = self.pose_at(hip, dz, rho);
                 p.period = self.period;
@@ -500,7 +503,7 @@ impl VirtualLeg {
             }
             self.period = FootPeriod::MetaOff;
             self.transitions[2] = Some(t);
-            self.rho = self.theta6_max.max(self.rho);
+            self.rho = meta_off_rho.max(self.rho);
             let p = self.pose_at(hip, dz, self.rho);
             self.meta_start = Some((t, p.knee));
         }
