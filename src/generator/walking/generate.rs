@@ -247,7 +247,9 @@ struct StepData {
     trail_origin: f64,
 }
 
-fn interp_rho(samples: &[(f64, f64)], t: f64) -> f64 {
+/// Linear interpolation of `(t, ρ)` roll samples at `t`, held at the end values outside them
+/// (the walk's frames and the stop read the virtual legs' recorded rolls this way).
+pub(super) fn interp_rho(samples: &[(f64, f64)], t: f64) -> f64 {
     if samples.is_empty() {
         return 0.0;
     }
@@ -773,7 +775,6 @@ fn assemble(
     let mut motion = Motion::new(skeleton.clone(), opt.fps, meta)?;
     let frames = (total * opt.fps).floor() as usize + 1;
     motion.reserve(frames);
-    let arm_gain = a.arm_swing_deg / 25.0;
     let swing_model = super::dynamics::SwingModel::new(body);
     for i in 0..frames {
         let t = (i as f64 / opt.fps).min(total);
@@ -857,14 +858,7 @@ fn assemble(
             Joint::Head,
             DQuat::from_rotation_y(yaw * (1.0 - a.spine_compensation)),
         );
-        // Arms swing with the opposite leg (flexion = −thigh angle).
-        for (side, opposite_thigh) in [(stance, swing_thigh), (swing, stance_thigh)] {
-            let [_, shoulder, elbow, _] = Joint::arm(side);
-            let flex = -arm_gain * opposite_thigh;
-            pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
-            let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
-            pose.set_euler(elbow, Euler::sagittal(elbow_flex));
-        }
+        swing_arms(&mut pose, a, [(stance, swing_thigh), (swing, stance_thigh)]);
         let mut contact = [false; 2];
         contact[match stance {
             Side::Left => 0,
@@ -980,20 +974,32 @@ fn closing_pose(
     pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_z(-f.lean));
     pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, 0.0));
     pose.set_world_rotation(Joint::Head, DQuat::IDENTITY);
-    let arm_gain = a.arm_swing_deg / 25.0;
-    for (side, opposite_thigh) in [(w, trail_thigh), (tr, stance_thigh)] {
-        let [_, shoulder, elbow, _] = Joint::arm(side);
-        let flex = -arm_gain * opposite_thigh;
-        pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
-        let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
-        pose.set_euler(elbow, Euler::sagittal(elbow_flex));
-    }
+    swing_arms(&mut pose, a, [(w, trail_thigh), (tr, stance_thigh)]);
     let mut contact = [true; 2];
     contact[match tr {
         Side::Left => 0,
         Side::Right => 1,
     }] = f.trail_contact;
     (pose, contact)
+}
+
+/// The arms swing with the opposite leg (§4.3): shoulder flexion = −(arm gain) × the opposite
+/// thigh's angle, the elbow flexed by its attribute plus half of any forward shoulder flexion.
+/// One rule for the walk and the stop, so the hands cannot jump where one hands over to the
+/// other. `sides`: (arm's side, opposite thigh angle θ3, rad).
+fn swing_arms(
+    pose: &mut crate::generator::skeleton::Pose,
+    a: &WalkAttributes,
+    sides: [(Side, f64); 2],
+) {
+    let arm_gain = a.arm_swing_deg / 25.0;
+    for (side, opposite_thigh) in sides {
+        let [_, shoulder, elbow, _] = Joint::arm(side);
+        let flex = -arm_gain * opposite_thigh;
+        pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
+        let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
+        pose.set_euler(elbow, Euler::sagittal(elbow_flex));
+    }
 }
 
 /// Thigh angle θ3 and knee flexion θ4 of the sagittal two-link chain from `hip` to `ankle`.

@@ -18,6 +18,7 @@
 //!   swing time of the last step (stride width kept), with zero velocity;
 //! - the trunk's lean returns to its reference angle.
 use super::foot::FootShape;
+use super::generate::interp_rho;
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
 use crate::events::Side;
 
@@ -155,18 +156,6 @@ pub struct ClosingFrame {
     pub trail_foot: ([f64; 2], f64, f64),
     /// Whether the trailing foot is on the ground.
     pub trail_contact: bool,
-}
-
-fn interp(samples: &[(f64, f64)], t: f64) -> f64 {
-    let k = samples.partition_point(|s| s.0 <= t);
-    if k == 0 {
-        return samples.first().map_or(0.0, |s| s.1);
-    }
-    if k >= samples.len() {
-        return samples[samples.len() - 1].1;
-    }
-    let (a, b) = (samples[k - 1], samples[k]);
-    a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0).max(1e-15)
 }
 
 /// Minimum-jerk bump: 0 with zero rate and acceleration at both ends, 1 at the middle.
@@ -329,14 +318,14 @@ impl Closing {
     pub fn frame(&self, t: f64, foot: &FootShape) -> ClosingFrame {
         let t = t.clamp(0.0, self.duration);
         let (hip, lateral) = self.hip_at(t);
-        let rho_s = interp(&self.stance_rho, t);
+        let rho_s = interp_rho(&self.stance_rho, t);
         let stance_foot = foot.rolled(
             self.stance_leg.flat_ankle,
             rho_s,
             self.stance_leg.theta6_max,
         );
         let (trail_foot, trail_contact) = if t <= self.toe_off {
-            let rho = interp(&self.trail_rho, t);
+            let rho = interp_rho(&self.trail_rho, t);
             (
                 foot.rolled(self.trail_leg.flat_ankle, rho, self.trail_leg.theta6_max),
                 true,

@@ -738,23 +738,3 @@ impl SwingSpec<'_> {
 pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
     (SwingModel::new(body), FootShape::new(body))
 }
-
-impl SwingRun {
-    /// Debug print of the trajectory (θ3, θ4 in degrees) every `every` nodes.
-    #[doc(hidden)]
-    pub fn dump(&self, spec: &SwingSpec<'_>, every: usize) -> String {
-        let mut s = String::new();
-        for (i, n) in self.track.nodes.iter().enumerate() {
-            if i % every == 0 {
-                let p = spec.foot_points(n.t, &n.q);
-                let (k, an) = spec.joints(n.t, &n.q);
-                let h = (spec.hip)(n.t);
-                s += &format!(
-                    "t {:.3} th3 {:7.2} th4 {:7.2} hip ({:.3},{:.3}) knee ({:.3},{:.3}) ankle ({:.3},{:.3}) heel {:.3} toe {:.3}\n",
-                    n.t, n.q[0].to_degrees(), n.q[1].to_degrees(), h.pos[0], h.pos[1], k[0], k[1], an[0], an[1], p.heel[1], p.toe[1]
-                );
-            }
-        }
-        s
-    }
-}
