@@ -283,6 +283,20 @@ fn side_z(side: Side, a: &WalkAttributes) -> f64 {
 /// [`VirtualLeg::min_knee_blend`]).
 const MIN_KNEE_BLEND: f64 = 0.3;
 
+/// Window over which the stance ankle's rate just after heel strike is measured, s.
+const CONTACT_RATE_WINDOW: f64 = 0.01;
+
+/// Largest ankle rate |θ̇5| the swing foot is given at heel strike, rad/s.
+///
+/// The stance ankle's rate just after heel strike is large (5–15 rad/s at 5–7 km/h: the
+/// dynamics' hip closes on the heel at ≈ 1–1.4 m/s along the leg and the straight knee cannot
+/// take it up, so the foot must roll about the heel), while the swing foot used to arrive with
+/// its ankle at rest — a one-frame spike of the ankle's rotation (continuity ratios 10–20).
+/// Matching the rate in full would need the swing ankle to dorsiflex 5–8° and snap back at
+/// 9–15 rad/s in the last 60 ms before contact, which no walker does; 3 rad/s keeps that bump
+/// below 2° (human ankles plantarflex at a few rad/s through loading response).
+pub const MAX_CONTACT_ANKLE_RATE: f64 = 3.0;
+
 /// Unrecorded steps simulated before a steady (not from rest) start.
 pub const PRE_ROLL: usize = 1;
 
@@ -532,9 +546,23 @@ pub fn generate_steps(
             .collect();
         stance_leg.plan_heel_rocker(&hips, a.heel_rocker_fraction * t_step);
         let mut stance_rho = Vec::with_capacity(n_s + 1);
+        let mut theta5_early = Vec::new();
         for &(t, hp, dz) in &hips {
             let p = stance_leg.advance(t, hp, dz);
             stance_rho.push((t, p.rho));
+            if t <= CONTACT_RATE_WINDOW + 1e-9 {
+                theta5_early.push((t, p.theta5));
+            }
+        }
+        // The previous step's swing foot lands into this heel rocker: its ankle ends swing3 with
+        // the rocker's early ankle rate (C¹ θ5 across heel strike, see `SwingFoot::theta56`).
+        if let (Some(prev), Some(&a), Some(&b)) =
+            (data.last_mut(), theta5_early.first(), theta5_early.last())
+        {
+            if kk > pre && b.0 > a.0 {
+                prev.swing_foot.theta5_rate_hs = ((b.1 - a.1) / (b.0 - a.0))
+                    .clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+            }
         }
         // 4. Swing.
         let t0 = t_ds;

@@ -85,19 +85,35 @@ pub struct SwingFoot {
     pub clearance: f64,
     /// Dorsiflexion limit of θ5, rad.
     pub theta5_max: f64,
+    /// Rate of θ5 at heel strike, rad/s: the landing foot's ankle rate just after heel strike
+    /// (bounded by `generate`'s `MAX_CONTACT_ANKLE_RATE`), set once the next stance's heel rocker
+    /// is planned; 0 while the swing is simulated (swing3's θ5 does not enter the dynamics).
+    pub theta5_rate_hs: f64,
 }
 
 impl SwingFoot {
     /// Interpolated θ5 and θ6 at `t` (before the clearance rule).
+    ///
+    /// In swing3 (`t2 → t3`) θ5 gets the cubic `ṙ·T3·(u − 1)·u²` (`u` the fraction of swing3,
+    /// `ṙ` = [`SwingFoot::theta5_rate_hs`]): zero with zero rate at `t2` and zero at heel strike,
+    /// where its rate is `ṙ`. The paper's interpolation brings the ankle to rest at heel strike,
+    /// while the stance foot starts rolling about the heel at once — a one-frame spike of the
+    /// ankle's rotation; this makes θ5 C¹ across the contact.
     pub fn theta56(&self, t: f64) -> (f64, f64) {
-        let [t0, t1, _, t3] = self.times;
+        let [t0, t1, t2, t3] = self.times;
         let [to, mid, hs] = self.theta5;
         let s1 = smoothstep((t - t0) / (t1 - t0));
-        let th5 = if t <= t1 {
+        let mut th5 = if t <= t1 {
             to + (mid - to) * s1
         } else {
             mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1))
         };
+        if t > t2 && t3 > t2 {
+            // Swing3 only: the cubic correction that leaves θ5 and its rate unchanged at t2 and
+            // its value at heel strike, and ends with the rate the stance foot takes on.
+            let u = ((t - t2) / (t3 - t2)).min(1.0);
+            th5 += self.theta5_rate_hs * (t3 - t2) * (u - 1.0) * u * u;
+        }
         (th5, self.theta6_toe_off * (1.0 - s1))
     }
 
@@ -256,6 +272,7 @@ impl SwingSpec<'_> {
             theta6_toe_off: self.theta6_toe_off,
             clearance: self.clearance,
             theta5_max: self.theta5_max,
+            theta5_rate_hs: 0.0,
         }
     }
 
@@ -737,4 +754,41 @@ impl SwingSpec<'_> {
 /// The body's swing model and foot.
 pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
     (SwingModel::new(body), FootShape::new(body))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn swing3_ankle_ends_with_the_contact_rate_and_keeps_its_ends() {
+        let body = Body::from_height(1.8, 75.0).unwrap();
+        let mut f = SwingFoot {
+            foot: FootShape::new(&body),
+            times: [0.1, 0.3, 0.44, 0.5],
+            theta5: [1.2, 1.75, 1.5708],
+            theta6_toe_off: 0.3,
+            clearance: 0.005,
+            theta5_max: 2.0,
+            theta5_rate_hs: 0.0,
+        };
+        let plain = f;
+        f.theta5_rate_hs = -3.0;
+        let th = |f: &SwingFoot, t: f64| f.theta56(t).0;
+        let e = 1e-6;
+        // Unchanged up to t2, with the same rate there; the heel-strike value kept.
+        for t in [0.1, 0.2, 0.3, 0.4, 0.44] {
+            assert_eq!(th(&f, t), th(&plain, t));
+        }
+        let rate = |f: &SwingFoot, t: f64| (th(f, t + e) - th(f, t - e)) / (2.0 * e);
+        assert!((rate(&f, 0.44 + e) - rate(&plain, 0.44 + e)).abs() < 1e-4);
+        assert!((th(&f, 0.5) - 1.5708).abs() < 1e-15);
+        // The rate at heel strike is the contact rate (the plain interpolation's is 0).
+        let end_rate = |f: &SwingFoot| (th(f, 0.5) - th(f, 0.5 - e)) / e;
+        assert!(end_rate(&plain).abs() < 1e-3, "{}", end_rate(&plain));
+        assert!((end_rate(&f) + 3.0).abs() < 1e-3, "{}", end_rate(&f));
+        // The price: a dorsiflexion bump of 4/27 · |ṙ| · T3 at two thirds of swing3.
+        let bump = th(&f, 0.44 + 0.06 * 2.0 / 3.0) - th(&plain, 0.44 + 0.06 * 2.0 / 3.0);
+        assert!((bump - 4.0 / 27.0 * 3.0 * 0.06).abs() < 1e-12, "{bump}");
+    }
 }
