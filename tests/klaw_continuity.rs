@@ -73,10 +73,10 @@ const BOUND_3KMH: f64 = 11.7; // measured 9.35 (frame 0, l_heel; was 15.1 at hee
 
 // klawhs (swing ankle plantarflexing into the contact): 5 km/h 18.4 → 9.35 (the heel strikes'
 // 13–18 → ≤ 8.1; the worst is now frame 0), 7 km/h 20.3 → 13.9 (frame 0; heel strikes ≤ 13.9),
-// schedule 19.5 → 16.6.
+// schedule 19.5 → 16.6 (10.3 with the least-bending heel-off roll).
 const BOUND_5KMH: f64 = 12.0; // measured 9.35 (frame 0, l_heel)
 const BOUND_7KMH: f64 = 17.5; // measured 13.9 (frame 0, l_ankle; r_ankle 13.9 at frame 47)
-const BOUND_SCHEDULE: f64 = 21.0; // measured 16.6 (frame 366, l_knee)
+const BOUND_SCHEDULE: f64 = 13.0; // measured 10.3 (frame 144, l_toe)
 
 /// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
 fn joint_steps(m: &gaitfit::generator::motion::Motion, joint: Joint) -> Vec<f64> {
