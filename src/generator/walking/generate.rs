@@ -409,6 +409,9 @@ pub fn generate_steps(
         heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch
     };
     let n = all.len();
+    // The last pre-roll step's stance roll (its start, samples): the recorded walk's first
+    // trailing leg is that leg, so its roll is smoothed across the two (see `smooth_rolls`).
+    let mut pre_stance: Option<(f64, Vec<(f64, f64)>)> = None;
     for (kk, l) in all.iter().enumerate() {
         let recorded = kk >= pre;
         let k = kk.saturating_sub(pre);
@@ -667,6 +670,8 @@ pub fn generate_steps(
                 trail_leg,
                 trail_origin: t_global - trailing_clock,
             });
+        } else {
+            pre_stance = Some((t_global, stance_rho));
         }
         // Next step.
         ankle_x[idx(swing_side)] = new_ankle_x;
@@ -678,7 +683,7 @@ pub fn generate_steps(
         t_global += t_step;
         from_rest = false;
     }
-    smooth_rolls(&mut data);
+    smooth_rolls(&mut data, pre_stance);
     // The stop: the trailing foot is brought alongside and the body comes to rest.
     let closing = match (opt.stop, data.last()) {
         (true, Some(d)) => {
@@ -743,7 +748,10 @@ const ROLL_TAU: f64 = 0.02;
 /// (dθ4/dd ∝ 1/θ4). Measured (8 steps, 1.8 m): a fixed 20 ms took the worst knee ratio at
 /// 1 km/h from 11.7 (rule) to 9.9, 10 ms to 7.9 but left 3 km/h's heel off at 5.1; the scaled
 /// time scale gives 6.5 (not at heel off) and 3 km/h below 4.
-fn smooth_rolls(data: &mut [StepData]) {
+///
+/// `pre`: the stance roll of the unrecorded pre-roll step before a steady start (its start,
+/// samples), whose leg is the first step's trailing leg.
+fn smooth_rolls(data: &mut [StepData], pre: Option<(f64, Vec<(f64, f64)>)>) {
     let smooth = |times: &[f64], rho: &mut Vec<f64>, knee_soft: f64| {
         let from = rho.iter().position(|&r| r >= 0.0).unwrap_or(rho.len());
         // Landing flat from the heel rocker: at rest.
@@ -751,13 +759,38 @@ fn smooth_rolls(data: &mut [StepData]) {
         let tau = ROLL_TAU * (knee_soft / KNEE_SOFT).clamp(0.0, 1.0).sqrt();
         smooth_roll(times, rho, from, rest, tau);
     };
-    // The first step's trailing leg: its stance before the walk is not recorded.
+    // The first step's trailing leg. After a pre-roll its stance began in the pre-roll step,
+    // so it is joined with the pre-roll's stance and smoothed as every later step's (smoothed
+    // alone over the recorded double support, its start was a free end: with the forward-mean
+    // smoother that was the 7 km/h × 1.5 m toe-bend jump at frame 2, ratio 25.5). From rest its
+    // stance begins with the walk.
     if let Some(d) = data.first_mut() {
-        let times: Vec<f64> = d.trail_rho.iter().map(|s| s.0).collect();
-        let mut rho: Vec<f64> = d.trail_rho.iter().map(|s| s.1).collect();
+        let (mut times, mut rho) = match &pre {
+            Some((start, samples)) => (
+                samples.iter().map(|s| start + s.0).collect::<Vec<f64>>(),
+                samples.iter().map(|s| s.1).collect::<Vec<f64>>(),
+            ),
+            None => (Vec::new(), Vec::new()),
+        };
+        let n0 = times.len();
+        let mut skipped = 0;
+        for &(t, r) in &d.trail_rho {
+            let g = d.start + t;
+            if times.last().is_some_and(|&l| g <= l + 1e-12) {
+                skipped += 1;
+                continue;
+            }
+            times.push(g);
+            rho.push(r);
+        }
         smooth(&times, &mut rho, d.trail_leg.knee_soft);
-        for (s, r) in d.trail_rho.iter_mut().zip(rho) {
-            s.1 = r;
+        let last = rho[n0.saturating_sub(1).min(rho.len().saturating_sub(1))];
+        for (i, s) in d.trail_rho.iter_mut().enumerate() {
+            s.1 = if i < skipped {
+                last
+            } else {
+                rho[n0 + i - skipped]
+            };
         }
     }
     for k in 0..data.len() {
