@@ -11,7 +11,7 @@
 //!
 //! Tighten the bounds when a fix lands; replace them by `passed` when KLAW meets k = 5.
 use gaitfit::events::EventKind;
-use gaitfit::generator::checks::{continuity, ContinuityOptions};
+use gaitfit::generator::checks::{continuity, continuity_over, ContinuityOptions};
 use gaitfit::generator::skeleton::Joint;
 use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
 
@@ -150,3 +150,97 @@ fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
 /// Worst ankle ratio within ± 3 frames of a heel strike, measured (klawhs) × 1.25.
 const HS_ANKLE_5KMH: f64 = 1.25 * 8.1;
 const HS_ANKLE_7KMH: f64 = 1.25 * 13.9;
+
+/// The start and the stop, region by region (`checks::continuity_over`: the same ratios, local
+/// medians over the whole motion, reported only for the steps that begin in the region), for
+/// 6-step walks with a stop at 1/2/3/5/7 km/h × 1.5/1.8/2.0 m, steady start and from standing:
+/// - *start*: frames before the second heel strike of the motion (steady: the first step,
+///   whose first frame has no history; from standing: the half step and the next, whose
+///   trailing foot stood through the half step);
+/// - *stop*: from the last step's heel strike to the end (the kinematic closing, `stop.rs`).
+///
+/// Regression guard like the one above (1.25 × the measurement of 2026-11-27 00:10 UTC on 684aeb1 + the
+/// stop's planned heel rocker), not the target
+/// k = 5. The stop is within 5 at 1–3 km/h (it was 5.3–7.0 at 1 and 3 km/h, 6–10 at 5–7 km/h:
+/// the straight-leg heel rocker slapped the foot flat and snapped the knee); what remains there
+/// is the ankle's heel-strike spike at 5–7 km/h (4.9–8.2). What remains at the start, located:
+/// steady start frame 0 — the landing heel is still 0.9–1.3 mm up at the exact heel strike (the
+/// sagittal heel-strike geometry of eq. 3 against the 3-D leg, whose hip is ≈ 4 cm beside the
+/// foot) and the ankle's heel-strike spike; within the region, the heel-strike ankle and
+/// toe-off knee spikes of every step; from standing, the first swings' swing1 (the ankle stays
+/// on the ground for most of it, then swing2 throws the foot forward).
+#[test]
+fn the_start_and_the_stop_do_not_regress() {
+    // (km/h, height, from standing, measured worst ratio over the start, over the stop)
+    #[rustfmt::skip]
+    let cases: &[(f64, f64, bool, f64, f64)] = &[
+        (1.0, 1.5, false, 8.0, 3.0), // start 12 l_knee, stop 684 l_knee
+        (1.0, 1.8, false, 9.4, 3.5), // start 0 l_heel, stop 751 l_knee
+        (1.0, 2.0, false, 13.2, 2.6), // start 0 l_heel, stop 793 l_knee
+        (2.0, 1.5, false, 8.5, 4.0), // start 51 r_knee, stop 482 l_heel
+        (2.0, 1.8, false, 9.9, 2.0), // start 88 r_knee, stop 531 l_ankle
+        (2.0, 2.0, false, 13.2, 2.4), // start 0 l_heel, stop 557 l_heel
+        (3.0, 1.5, false, 4.5, 3.3), // start 0 l_heel, stop 395 l_ankle
+        (3.0, 1.8, false, 9.4, 2.9), // start 0 l_heel, stop 433 l_ankle
+        (3.0, 2.0, false, 13.2, 2.7), // start 0 l_heel, stop 457 l_ankle
+        (5.0, 1.5, false, 11.8, 4.5), // start 13 r_knee, stop 305 l_heel
+        (5.0, 1.8, false, 9.4, 6.0), // start 0 l_heel, stop 335 l_ankle
+        (5.0, 2.0, false, 13.2, 4.9), // start 0 l_heel, stop 352 l_heel
+        (7.0, 1.5, false, 12.3, 6.1), // start 43 r_ankle, stop 258 l_ankle
+        (7.0, 1.8, false, 14.0, 7.9), // start 0 l_ankle, stop 283 l_ankle
+        (7.0, 2.0, false, 13.2, 4.1), // start 0 l_heel, stop 298 l_ankle
+        (1.0, 1.5, true, 7.2, 3.0), // start 194 l_ankle, stop 684 l_knee
+        (1.0, 1.8, true, 6.0, 3.4), // start 112 l_shoulder, stop 751 l_knee
+        (1.0, 2.0, true, 6.6, 2.8), // start 112 r_knee, stop 793 l_knee
+        (2.0, 1.5, true, 9.9, 4.1), // start 134 l_ankle, stop 482 l_heel
+        (2.0, 1.8, true, 12.6, 2.0), // start 144 l_toe, stop 531 l_ankle
+        (2.0, 2.0, true, 9.0, 2.5), // start 153 l_toe, stop 557 l_heel
+        (3.0, 1.5, true, 5.3, 3.3), // start 106 l_ankle, stop 395 l_ankle
+        (3.0, 1.8, true, 5.6, 2.9), // start 64 l_hand, stop 433 l_ankle
+        (3.0, 2.0, true, 6.0, 2.7), // start 67 l_shoulder, stop 457 l_ankle
+        (5.0, 1.5, true, 11.4, 5.1), // start 51 r_knee, stop 305 l_heel
+        (5.0, 1.8, true, 10.6, 6.1), // start 68 r_heel, stop 335 l_ankle
+        (5.0, 2.0, true, 4.8, 4.9), // start 58 r_heel, stop 352 l_heel
+        (7.0, 1.5, true, 12.2, 6.1), // start 86 l_ankle, stop 258 l_ankle
+        (7.0, 1.8, true, 9.5, 7.9), // start 94 l_ankle, stop 283 l_ankle
+        (7.0, 2.0, true, 7.6, 4.1), // start 50 l_knee, stop 298 l_ankle
+    ];
+    let mut failures = Vec::new();
+    for &(kmh, h, rest, start_ratio, stop_ratio) in cases {
+        let opts = WalkOptions {
+            height_m: h,
+            start_from_rest: rest,
+            stop: true,
+            ..Default::default()
+        };
+        let schedule = [ScheduleEntry {
+            params: WalkParams {
+                speed_m_per_s: Some(kmh / 3.6),
+                ..Default::default()
+            },
+            steps: 6,
+        }];
+        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let hs: Vec<f64> = m
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::HeelStrike)
+            .map(|e| e.time_s * m.fps())
+            .collect();
+        assert!(hs.len() >= 4, "{kmh} km/h {h} m: {} heel strikes", hs.len());
+        let o = ContinuityOptions::default();
+        let start = continuity_over(&m, &o, 0..hs[1].ceil() as usize);
+        let stop = continuity_over(&m, &o, hs[hs.len() - 2].floor() as usize..m.len());
+        println!("{kmh} km/h {h} m from standing {rest}: start {start}; stop {stop}");
+        for (what, r, measured) in [("start", &start, start_ratio), ("stop", &stop, stop_ratio)] {
+            assert!(r.examined > 100, "{what}: {} examined", r.examined);
+            if r.worst > 1.25 * measured {
+                failures.push(format!(
+                    "{kmh} km/h {h} m from standing {rest}, {what}: {:.1} > 1.25 × {measured}",
+                    r.worst
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -278,6 +278,17 @@ impl Default for ContinuityOptions {
 /// the floor). `worst` is the largest ratio step / local median (dimensionless); the frame is the
 /// first frame of the step. Passes when `worst ≤ options.k`.
 pub fn continuity(motion: &Motion, options: &ContinuityOptions) -> CheckReport {
+    continuity_over(motion, options, 0..motion.len())
+}
+
+/// [`continuity`] restricted to the steps that begin at the frames `frames` (e.g. the first step
+/// of a walk, or its stop); the local medians still use the whole motion, so a step at the
+/// range's edge is judged exactly as in [`continuity`].
+pub fn continuity_over(
+    motion: &Motion,
+    options: &ContinuityOptions,
+    frames: Range<usize>,
+) -> CheckReport {
     let n = motion.len();
     let mut w = Worst::new(0.0);
     if n < 3 {
@@ -286,7 +297,7 @@ pub fn continuity(motion: &Motion, options: &ContinuityOptions) -> CheckReport {
     let mut steps = vec![0.0; n - 1];
     let mut scratch = Vec::with_capacity(2 * options.window);
     let mut scan = |steps: &[f64], floor: f64, name: &str, w: &mut Worst| {
-        for i in 0..steps.len() {
+        for i in frames.start..frames.end.min(steps.len()) {
             scratch.clear();
             let lo = i.saturating_sub(options.window);
             let hi = (i + options.window + 1).min(steps.len());

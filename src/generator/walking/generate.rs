@@ -715,6 +715,7 @@ pub fn generate_steps(
                 clearance: a.toe_clearance_m,
                 trail_clock: trailing_clock,
                 min_knee_blend: MIN_KNEE_BLEND * d.times.double_support,
+                heel_rocker_min: a.heel_rocker_fraction * d.times.step,
             };
             let lead = mk_leg(ankle_x[idx(w)], FootPeriod::HeelRocker, -prev_hs_pitch);
             Some(Closing::new(

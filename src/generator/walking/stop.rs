@@ -107,6 +107,10 @@ pub struct StopStart {
     pub trail_clock: f64,
     /// Shortest meta-off knee flexion of the trailing leg, s.
     pub min_knee_blend: f64,
+    /// Shortest planned heel rocker of the leading leg, s (as in the walk's steps:
+    /// `heel_rocker_fraction` × the last step's duration; see
+    /// [`VirtualLeg::plan_heel_rocker`]).
+    pub heel_rocker_min: f64,
 }
 
 /// The closing motion after the last heel strike (times from that heel strike).
@@ -240,17 +244,42 @@ impl Closing {
             toe_off_pose: (0.0, 0.0),
             lift: g.clearance + SWING_LIFT,
         };
-        // The leading foot: heel rocker until flat, then flat.
+        // The leading foot: heel rocker until flat, then flat. The rocker is planned as in the
+        // walk's steps (the knee flexes from straight along a C¹ curve to the flat foot's knee
+        // angle and rate, the roll following): the straight-leg rule slapped the foot flat within
+        // 3–5 frames and then snapped the knee from straight to the leg's shortening (its
+        // flexion ∝ √(l1 − r)), 0.1 rad in one frame, the hip and arms following (continuity
+        // ratios 6–9 at every speed).
         let dt = 2e-3;
         let n = ((c.duration / dt).ceil() as usize).max(2);
+        let hips: Vec<(f64, [f64; 2], f64)> = (0..=n)
+            .map(|i| {
+                let t = c.duration * i as f64 / n as f64;
+                let (hip, z) = c.hip_at(t);
+                (t, hip, z + g.hip_z[0] - g.ankle_z[0])
+            })
+            .collect();
+        // The heel strike's geometry (eq. 3) is sagittal but the leg is drawn in 3-D, its hip
+        // ≈ 4 cm beside the foot: at the heel strike the straight leg may fall up to a millimetre
+        // short of the landing pitch's ankle, and a slow walker's hip takes a few frames to come
+        // that much closer. The plan's knee starts flexing only once the leg reaches (before, the
+        // foot holds its landing pitch and the knee stays straight), else the drawn knee, held
+        // straight by the reach, caught up with the plan in one frame (ratio 8–9 at 1 km/h).
+        let reach_from = hips
+            .iter()
+            .position(|&(_, hip, dz)| {
+                let p = stance_leg.pose_at(hip, dz, stance_leg.rho);
+                let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+                (hip[0] - p.ankle[0]).hypot(dy) <= stance_leg.l3 + stance_leg.l4
+            })
+            .unwrap_or(0);
+        stance_leg.plan_heel_rocker(&hips[reach_from..], g.heel_rocker_min);
         let mut flat = false;
-        for i in 0..=n {
-            let t = c.duration * i as f64 / n as f64;
-            let (hip, z) = c.hip_at(t);
+        for &(t, hip, dz) in &hips {
             let rho = if flat {
                 0.0
             } else {
-                let p = stance_leg.advance(t, hip, z + g.hip_z[0] - g.ankle_z[0]);
+                let p = stance_leg.advance(t, hip, dz);
                 if stance_leg.period != FootPeriod::HeelRocker {
                     flat = true;
                     c.stance_flat = Some(t);
