@@ -159,11 +159,11 @@ const HS_ANKLE_7KMH: f64 = 1.25 * 13.9;
 ///   trailing foot stood through the half step);
 /// - *stop*: from the last step's heel strike to the end (the kinematic closing, `stop.rs`).
 ///
-/// Regression guard like the one above (1.25 × the measurement of 2026-11-27 00:10 UTC on 684aeb1 + the
-/// stop's planned heel rocker), not the target
-/// k = 5. The stop is within 5 at 1–3 km/h (it was 5.3–7.0 at 1 and 3 km/h, 6–10 at 5–7 km/h:
-/// the straight-leg heel rocker slapped the foot flat and snapped the knee); what remains there
-/// is the ankle's heel-strike spike at 5–7 km/h (4.9–8.2). What remains at the start, located:
+/// Regression guard like the one above (1.25 × the measurement of 2026-11-27 00:05 UTC on
+/// 684aeb1 + the stop's planned heel rocker), not the target k = 5. The stop is within 5 at
+/// 1–3 km/h (it was 5.3–7.0 at 1 and 3 km/h, 6–10 at 5–7 km/h: the straight-leg heel rocker
+/// slapped the foot flat and snapped the knee); what remains there is the ankle's heel-strike
+/// spike at 5–7 km/h (4.5–7.9). What remains at the start, located:
 /// steady start frame 0 — the landing heel is still 0.9–1.3 mm up at the exact heel strike (the
 /// sagittal heel-strike geometry of eq. 3 against the 3-D leg, whose hip is ≈ 4 cm beside the
 /// foot) and the ankle's heel-strike spike; within the region, the heel-strike ankle and

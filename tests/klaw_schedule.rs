@@ -304,3 +304,135 @@ fn the_cli_stop_ends_with_the_trailing_foot_landing() {
         "{events}"
     );
 }
+
+/// Walks of 6 steps from standing to a stop at `v` km/h and height `h`.
+fn from_standing(v: f64, h: f64) -> Motion {
+    let opts = WalkOptions {
+        height_m: h,
+        start_from_rest: true,
+        stop: true,
+        ..Default::default()
+    };
+    generate_walk(&[kmh(v, 6)], &opts).unwrap().0
+}
+
+/// From standing at 1, 2 and 3 km/h × 1.5/1.8/2.0 m, no foot point goes more than 1 mm into the
+/// ground (`checks::ground_penetration`, every frame, both feet).
+///
+/// **Not met at 1 km/h** (the first swing, right after toe off: 1.5, 2.6 and 3.2 mm on main
+/// 684aeb1): the first swing leg stood on a flat foot through the half step's double support
+/// (the hip never gets far enough ahead for the virtual leg to roll it), so the swing starts
+/// from a flat foot at rest, and swing1's slaved knee keeps the ankle on its curve's near branch
+/// — the ankle hardly moves forward or up for most of swing1 while the swing foot's toe
+/// clearance pitches the foot toe-up, which sinks the heel. Those three cases are guarded at
+/// 1.25 × their measurement (listed below) until swing1 handles a swing from a standstill; the
+/// others must pass.
+#[test]
+fn swing_heel_stays_out_of_the_ground_from_standing() {
+    // (km/h, height): measured depth, m, where the 1 mm target is not met yet.
+    const KNOWN: [(f64, f64, f64); 3] = [
+        (1.0, 1.5, 0.00151),
+        (1.0, 1.8, 0.00258),
+        (1.0, 2.0, 0.00323),
+    ];
+    let mut failures = Vec::new();
+    for v in [1.0, 2.0, 3.0] {
+        for h in [1.5, 1.8, 2.0] {
+            let m = from_standing(v, h);
+            let pen = ground_penetration(&m, 0.001);
+            let known = KNOWN.iter().find(|k| k.0 == v && k.1 == h);
+            println!("{v} km/h {h} m: {pen}");
+            match known {
+                None if !pen.passed => failures.push(format!("{v} km/h {h} m: {pen}")),
+                Some(k) if pen.worst > 1.25 * k.2 => {
+                    failures.push(format!("{v} km/h {h} m (known): {pen} > 1.25 × {}", k.2))
+                }
+                _ => {}
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Peak over mean speed of each swing's ankle, in time order: the largest 3-D frame-to-frame
+/// speed from the frame before toe off to the landing frame, over the straight-line distance
+/// between those two positions per the swing's duration.
+fn swing_peak_over_mean(m: &Motion) -> Vec<f64> {
+    let fps = m.fps();
+    let mut runs = Vec::new();
+    for (side, ankle) in [
+        (Side::Left, Landmark::LAnkle),
+        (Side::Right, Landmark::RAnkle),
+    ] {
+        for r in gaitfit::generator::checks::swing_runs(m, side) {
+            if r.end < m.len() {
+                runs.push((r, ankle));
+            }
+        }
+    }
+    runs.sort_by_key(|r| r.0.start);
+    runs.into_iter()
+        .map(|(r, ankle)| {
+            let (a, b) = (r.start.saturating_sub(1), r.end);
+            let peak = (a..b)
+                .map(|i| (m.landmark(i + 1, ankle) - m.landmark(i, ankle)).length() * fps)
+                .fold(0.0, f64::max);
+            let mean =
+                (m.landmark(b, ankle) - m.landmark(a, ankle)).length() * fps / (b - a) as f64;
+            peak / mean
+        })
+        .collect()
+}
+
+/// The swing ankle's peak speed. The bound is relative to the swing's own mean ankle speed, not
+/// to the walking speed: a human swing ankle peaks at 3.0 × the walking speed (Winter's Table
+/// A.1, `../shared/data/bmclab/WinterTableA1.txt`: 4.30 m/s at 1.44 m/s), but the swing's mean
+/// speed (stride over swing time) is itself 2–3 × the walking speed and grows as the swing's
+/// share of the cycle shrinks in slow walks, and a swing from standing covers a half or 1.5
+/// step in a full swing time — so the fair measure is peak / mean: Winter 1.41 (4.30 over
+/// 3.04 m/s), a minimum-jerk path 1.875. Target: ≤ 2.5.
+///
+/// Met by steady swings at 5 and 7 km/h (1.6–1.9, asserted). **Not met from standing**: the
+/// first swing (4.3–14.6) and at 1–3 km/h the second (2.5–8.9), thrown forward in swing2 after
+/// a swing1 whose ankle barely moves (see the penetration test above); nor by steady swings at
+/// 1–2 km/h (4–6, swing2's knee extension). The first two swings from standing are guarded at
+/// 1.25 × their measurement on main 684aeb1.
+#[test]
+fn swing_ankle_peak_speed_from_standing() {
+    // Steady 5 and 7 km/h: the target.
+    for v in [5.0, 7.0] {
+        let (m, _) = generate_walk(&[kmh(v, 6)], &WalkOptions::default()).unwrap();
+        let r = swing_peak_over_mean(&m);
+        println!("steady {v} km/h: {r:.2?}");
+        assert!(r.len() >= 5, "{r:?}");
+        for x in &r {
+            assert!(
+                *x <= 2.5,
+                "steady {v} km/h: swing ankle peak / mean {x:.2} > 2.5"
+            );
+        }
+    }
+    // From standing at 1.8 m: (km/h, first swing, second swing) measured.
+    const MEASURED: [(f64, f64, f64); 5] = [
+        (1.0, 14.64, 4.28),
+        (2.0, 10.91, 7.50),
+        (3.0, 5.18, 2.65),
+        (5.0, 4.62, 1.72),
+        (7.0, 4.41, 1.61),
+    ];
+    let mut failures = Vec::new();
+    for (v, first, second) in MEASURED {
+        let r = swing_peak_over_mean(&from_standing(v, 1.8));
+        println!("from standing {v} km/h: {r:.2?}");
+        assert!(r.len() >= 4, "{r:?}");
+        for (k, measured) in [(0, first), (1, second)] {
+            if r[k] > 1.25 * measured {
+                failures.push(format!(
+                    "{v} km/h swing {k}: {:.2} > 1.25 × {measured}",
+                    r[k]
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
