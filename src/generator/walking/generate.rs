@@ -547,6 +547,17 @@ pub fn generate_steps(
                 (t, hp, hz - zf_s)
             })
             .collect();
+        // The recorded walk's first frame is exactly at this heel strike, where the straight leg
+        // falls up to ≈ 1 mm short of the landing pitch's ankle (eq. 3's sagittal geometry
+        // against the 3-D leg, whose hip is ≈ 4 cm beside the foot): that frame drew the heel
+        // 0.9–1.3 mm in the air and the next on the ground, a heel step after none (continuity
+        // 9.4–13.1 at frame 0 of every steady walk). The first stance foot lands pitched just
+        // enough more for the leg to reach (≈ 0.01 rad; the frame has no predecessor, and the
+        // planned rocker takes the extra pitch out over its whole duration). Later heel strikes
+        // fall between frames, where the approaching hip has already closed the gap.
+        if recorded && k == 0 && !opt.start_from_rest {
+            stance_leg.rho = reachable_landing_roll(&stance_leg, hips[0].1, hips[0].2);
+        }
         stance_leg.plan_heel_rocker(&hips, a.heel_rocker_fraction * t_step);
         let mut stance_rho = Vec::with_capacity(n_s + 1);
         let mut theta5_early = Vec::new();
@@ -1111,6 +1122,31 @@ fn place_leg(
     (h.x - kn.x).atan2(h.y - kn.y)
 }
 
+/// The heel-rocker roll at which the straight leg `leg` reaches its ankle from the hip at `hip`
+/// (lateral offset `dz`) with the heel on the ground: `leg.rho` if it already does, else the
+/// nearest more pitched roll that does (bisection down to −1.2 rad, 60 halvings).
+fn reachable_landing_roll(leg: &VirtualLeg, hip: [f64; 2], dz: f64) -> f64 {
+    let l1 = leg.l3 + leg.l4;
+    let reach = |r: f64| {
+        let p = leg.pose_at(hip, dz, r);
+        let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+        (hip[0] - p.ankle[0]).hypot(dy) - l1
+    };
+    let (mut lo, mut hi) = (-1.2, leg.rho.min(0.0));
+    if reach(hi) <= 0.0 || reach(lo) > 0.0 {
+        return leg.rho;
+    }
+    for _ in 0..60 {
+        let m = 0.5 * (lo + hi);
+        if reach(m) > 0.0 {
+            hi = m;
+        } else {
+            lo = m;
+        }
+    }
+    lo
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1151,5 +1187,57 @@ mod tests {
             assert!(d.swing_hip_offset(0.0)[0] < 0.0 && d.swing_hip_offset(0.56)[0] > 0.0);
             assert!(d.swing_hip_offset(0.28)[1] < 0.0 && d.swing_hip_offset(0.0)[1].abs() < 1e-12);
         }
+    }
+
+    #[test]
+    fn landing_roll_puts_the_straight_leg_in_reach_with_the_heel_down() {
+        let body = Body::from_height(1.8, 75.0).unwrap();
+        let foot = FootShape::new(&body);
+        let leg = VirtualLeg {
+            foot,
+            l3: body.l3,
+            l4: body.l4,
+            flat_ankle: [0.0, body.l9],
+            theta5_max: 100f64.to_radians(),
+            theta6_max: 30f64.to_radians(),
+            knee_toe_off: 35f64.to_radians(),
+            toe_off_time: 1.0,
+            min_knee_blend: 0.0,
+            period: FootPeriod::HeelRocker,
+            rho: -0.3,
+            meta_start: None,
+            transitions: [None; 3],
+            rocker: None,
+            knee_soft: super::super::virtual_leg::KNEE_SOFT,
+        };
+        let l1 = body.l3 + body.l4;
+        let dist = |r: f64, hip: [f64; 2], dz: f64| {
+            let p = leg.pose_at(hip, dz, r);
+            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+            (hip[0] - p.ankle[0]).hypot(dy)
+        };
+        // A hip 1 mm beyond the straight leg's reach of the landing pitch's ankle, 4 cm aside.
+        let dz = 0.04;
+        let (ankle, _, _) = foot.rolled(leg.flat_ankle, leg.rho, leg.theta6_max);
+        let a = 20f64.to_radians();
+        let r = ((l1 + 0.001).powi(2) - dz * dz).sqrt();
+        let hip = [ankle[0] - r * a.sin(), ankle[1] + r * a.cos()];
+        assert!(dist(leg.rho, hip, dz) > l1 + 0.0009);
+        let rho = reachable_landing_roll(&leg, hip, dz);
+        // More pitched, by about 1 mm over the heel-to-ankle lever, and just within reach.
+        assert!(rho < leg.rho && rho > leg.rho - 0.05, "{rho}");
+        let d = dist(rho, hip, dz);
+        assert!(d <= l1 && d > l1 - 1e-9, "{}", d - l1);
+        // The heel stays where it landed.
+        let heel = |r: f64| {
+            foot.points(foot.rolled(leg.flat_ankle, r, leg.theta6_max).0, -r, 0.0)
+                .heel
+        };
+        assert!((heel(rho)[0] - heel(leg.rho)[0]).abs() < 1e-12);
+        assert!((heel(rho)[1] - heel(leg.rho)[1]).abs() < 1e-12);
+        // Already in reach: unchanged.
+        let near = [hip[0] + 0.01, hip[1] - 0.01];
+        assert!(dist(leg.rho, near, dz) < l1);
+        assert_eq!(reachable_landing_roll(&leg, near, dz), leg.rho);
     }
 }
