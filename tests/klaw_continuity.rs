@@ -247,3 +247,63 @@ fn the_start_and_the_stop_do_not_regress() {
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Worst continuity ratio of `joint_of(side)` within ± 3 frames of the walk's heel strikes (those
+/// with 4 frames before and after), and the number of contacts examined.
+fn contact_ratio(
+    m: &gaitfit::generator::motion::Motion,
+    joint_of: impl Fn(gaitfit::events::Side) -> Joint,
+) -> (f64, usize) {
+    let fps = m.fps();
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for e in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
+        let f = (e.time_s * fps - 1e-9).ceil() as usize;
+        if f < 5 || f + 5 >= m.len() {
+            continue;
+        }
+        let s = joint_steps(m, joint_of(e.side));
+        for i in f - 3..=f + 2 {
+            let mut nb: Vec<f64> = s[i - 3..i]
+                .iter()
+                .chain(&s[i + 1..i + 4])
+                .copied()
+                .collect();
+            nb.sort_by(f64::total_cmp);
+            worst = worst.max(s[i] / (0.5 * (nb[2] + nb[3])).max(1e-3));
+        }
+        checked += 1;
+    }
+    (worst, checked)
+}
+
+/// Slow walks: the stance knee leaves heel strike from rest (C¹ with the swing's locked knee;
+/// the planned heel rocker's start rate may now be 0), where it used to start at its mean rate
+/// and then slow down (1 km/h, 1.5 m: knee ratio 6.3–6.5 at every contact).
+#[test]
+fn slow_walk_knee_leaves_heel_strike_from_rest() {
+    for h in [1.5, 1.8, 2.0] {
+        let schedule = [ScheduleEntry {
+            params: WalkParams {
+                speed_m_per_s: Some(1.0 / 3.6),
+                ..Default::default()
+            },
+            steps: 6,
+        }];
+        let opts = WalkOptions {
+            height_m: h,
+            ..Default::default()
+        };
+        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let (worst, checked) = contact_ratio(&m, |s| Joint::leg(s)[1]);
+        println!("1 km/h, {h} m: worst knee ratio over {checked} contacts {worst:.2}");
+        assert!(checked >= 4);
+        assert!(
+            worst <= SLOW_KNEE_BOUND,
+            "1 km/h, {h} m: knee ratio {worst:.2}"
+        );
+    }
+}
+
+/// Worst knee ratio within ± 3 frames of a contact at 1 km/h, 1.5–2.0 m (3.84 at 1.5 m) × 1.25.
+const SLOW_KNEE_BOUND: f64 = 4.8;

@@ -387,6 +387,7 @@ pub fn generate_steps(
         transitions: [None; 3],
         rocker: None,
         knee_soft: super::virtual_leg::KNEE_SOFT,
+        slow_knee_start: true,
     };
     let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
     let mut trailing_clock = 0.0;
@@ -728,7 +729,8 @@ pub fn generate_steps(
                 min_knee_blend: MIN_KNEE_BLEND * d.times.double_support,
                 heel_rocker_min: a.heel_rocker_fraction * d.times.step,
             };
-            let lead = mk_leg(ankle_x[idx(w)], FootPeriod::HeelRocker, -prev_hs_pitch);
+            let mut lead = mk_leg(ankle_x[idx(w)], FootPeriod::HeelRocker, -prev_hs_pitch);
+            lead.slow_knee_start = false;
             Some(Closing::new(
                 t_global,
                 w,

@@ -101,6 +101,10 @@ pub struct VirtualLeg {
     /// Width of the knee's soft straightening in late stance, m (see [`KNEE_SOFT`]; narrower
     /// when a planned heel rocker lands with the knee nearly straight).
     pub knee_soft: f64,
+    /// Whether a planned heel rocker may start the knee slower than its mean rate, down to
+    /// rest, in slow walks (see [`VirtualLeg::plan_heel_rocker`]). The walk's steps do; the
+    /// stop's landing does not (measured worse there: 3 km/h 2.9 → 4.0, 5 km/h 6.0 → 7.8).
+    pub slow_knee_start: bool,
 }
 
 /// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
@@ -403,7 +407,9 @@ impl VirtualLeg {
     /// 2–5 frames of heel strike (KLAW's hip approaches the foot at ≈ 1 m/s just after the
     /// collision) and the knee snaps from straight to the flat period's flexion (continuity
     /// ratios 10–40). Here the *knee* is planned instead: from straight at heel strike it
-    /// flexes along a cubic Hermite curve (leaving at its mean rate) to the flat foot's knee
+    /// flexes along a cubic Hermite curve (leaving at the slowest of 1–3× its mean rate that
+    /// works, or slower — down to rest, C¹ with the swing's locked knee — where the flat foot's
+    /// knee rate exceeds the mean: slow walks) to the flat foot's knee
     /// flexion and rate at the end `T`; at each sample the roll is the one that puts the ankle
     /// at the distance that knee spans (clamped to the heel-strike pitch and to flat, never
     /// decreasing). At `T` the roll reaches 0 at rest (the flat foot's knee is met with its rate),
@@ -488,33 +494,62 @@ impl VirtualLeg {
             };
             // The slowest start (mean rate × 1, 1.25, …, 3) whose knee stays at least as flexed
             // as the flat foot would make it: the foot then lands only at `end`.
-            let Some(start_rate) = [1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0]
-                .iter()
-                .map(|f| f * k_end / big_t)
-                .find(|&r0| {
-                    samples[..kt].iter().zip(d_flat).all(|(&(t, _, _), &df)| {
-                        knee_at(t, r0) >= knee_for(l3, l4, df.min(l1)) - 1e-6
-                    })
-                })
+            let valid = |f: f64| {
+                let r0 = f * k_end / big_t;
+                samples[..kt]
+                    .iter()
+                    .zip(d_flat)
+                    .all(|(&(t, _, _), &df)| knee_at(t, r0) >= knee_for(l3, l4, df.min(l1)) - 1e-6)
+            };
+            let Some(f_mean) = [1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0]
+                .into_iter()
+                .find(|&f| valid(f))
             else {
                 continue;
             };
-            let mut table = Vec::with_capacity(kt);
-            let mut last = -pitch;
-            for &(t, hip, dz) in &samples[..kt] {
-                let knee = knee_at(t, start_rate);
-                let target = span_for(l3, l4, knee.max(0.0)).min(l1);
-                let g = |r: f64| dist(r, hip, dz) - target;
-                let r = if g(0.0) <= 0.0 {
-                    0.0
-                } else if g(-pitch) >= 0.0 {
-                    -pitch
-                } else {
-                    root_nonpositive_side(&g, 0.0, -pitch)
-                };
-                last = r.max(last);
-                table.push((t, last));
+            let table_for = |f: f64| {
+                let start_rate = f * k_end / big_t;
+                let mut table = Vec::with_capacity(kt);
+                let mut last = -pitch;
+                for &(t, hip, dz) in &samples[..kt] {
+                    let knee = knee_at(t, start_rate);
+                    let target = span_for(l3, l4, knee.max(0.0)).min(l1);
+                    let g = |r: f64| dist(r, hip, dz) - target;
+                    let r = if g(0.0) <= 0.0 {
+                        0.0
+                    } else if g(-pitch) >= 0.0 {
+                        -pitch
+                    } else {
+                        root_nonpositive_side(&g, 0.0, -pitch)
+                    };
+                    last = r.max(last);
+                    table.push((t, last));
+                }
+                table
+            };
+            // When the flat foot's knee rate at `end` exceeds the mean rate (slow walks: the hip
+            // still descends as the foot lands), a start at the mean rate makes the knee's rate
+            // dip mid-rocker and rise again — a knee that flexes, nearly stops and flexes again
+            // (continuity ratios ≈ 6.5 at heel strike at 1 km/h). There the knee leaves heel
+            // strike at the slowest valid rate below the mean, down to rest (C¹ with the swing's
+            // locked knee), so its rate rises toward the flat foot's — unless the landing is
+            // already as quick as this pass allows (within ×1.2 of its shortest): the knee must
+            // then help from the start, or the foot slaps down harder (toe 5.0 cm/frame on the
+            // 5 → 3 km/h step of a schedule).
+            let mut f = f_mean;
+            if self.slow_knee_start
+                && f_mean == 1.0
+                && k_rate * big_t > k_end
+                && big_t >= 1.2 * min_duration
+            {
+                for slower in [0.75, 0.5, 0.25, 0.0] {
+                    if !valid(slower) {
+                        break;
+                    }
+                    f = slower;
+                }
             }
+            let table = table_for(f);
             self.rocker = Some(HeelRocker { end, table });
             let landing = d_flat[kt - 1].max(d_flat[kt]).max(d_flat[kt + 1]);
             self.knee_soft = self.knee_soft.min(soft.max(0.5 * (l1 - landing)));
@@ -658,6 +693,7 @@ mod tests {
             transitions: [None; 3],
             rocker: None,
             knee_soft: KNEE_SOFT,
+            slow_knee_start: true,
         }
     }
 
