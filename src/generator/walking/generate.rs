@@ -1211,6 +1211,7 @@ mod tests {
             transitions: [None; 3],
             rocker: None,
             knee_soft: super::super::virtual_leg::KNEE_SOFT,
+            slow_knee_start: true,
         };
         let l1 = body.l3 + body.l4;
         let dist = |r: f64, hip: [f64; 2], dz: f64| {
