@@ -742,6 +742,13 @@ pub fn generate_steps(
         }
         _ => None,
     };
+    // The last step's swing foot lands into the stop's heel rocker as every other lands into
+    // the next step's: its ankle ends swing3 at the rocker's early ankle rate.
+    if let (Some(c), Some(d)) = (closing.as_ref(), data.last_mut()) {
+        d.swing_foot.theta5_rate_hs = c
+            .contact_ankle_rate(CONTACT_RATE_WINDOW)
+            .clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+    }
     let total = t_global + closing.as_ref().map_or(0.0, |c| c.duration);
     let motion = assemble(&skeleton, &body, &foot, &data, opt, total, closing.as_ref())?;
     Ok((motion, report))

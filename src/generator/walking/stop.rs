@@ -137,6 +137,8 @@ pub struct Closing {
     geo: StopStart,
     stance_leg: VirtualLeg,
     stance_rho: Vec<(f64, f64)>,
+    /// The landing foot's ankle angle θ5 over the first [`EARLY`] s, `(t, θ5)`.
+    stance_theta5: Vec<(f64, f64)>,
     trail_leg: VirtualLeg,
     trail_rho: Vec<(f64, f64)>,
     ankle_x: Quintic,
@@ -161,6 +163,10 @@ pub struct ClosingFrame {
     /// Whether the trailing foot is on the ground.
     pub trail_contact: bool,
 }
+
+/// How long the landing foot's early ankle angle is kept, s (see
+/// [`Closing::contact_ankle_rate`]).
+const EARLY: f64 = 0.05;
 
 /// Minimum-jerk bump: 0 with zero rate and acceleration at both ends, 1 at the middle.
 fn bump(s: f64) -> f64 {
@@ -237,6 +243,7 @@ impl Closing {
             geo: geo.clone(),
             stance_leg: stance_leg.clone(),
             stance_rho: Vec::new(),
+            stance_theta5: Vec::new(),
             trail_leg: trail_leg.clone(),
             trail_rho: Vec::new(),
             ankle_x: Quintic::new([0.0; 3], [0.0; 3], 1.0),
@@ -280,6 +287,9 @@ impl Closing {
                 0.0
             } else {
                 let p = stance_leg.advance(t, hip, dz);
+                if t <= EARLY {
+                    c.stance_theta5.push((t, p.theta5));
+                }
                 if stance_leg.period != FootPeriod::HeelRocker {
                     flat = true;
                     c.stance_flat = Some(t);
@@ -325,6 +335,25 @@ impl Closing {
         c.ankle_y = Quintic::new([ankle0[1], va[1], 0.0], [g.ankle_height, 0.0, 0.0], ds);
         c.toe_off_pose = (pitch0, bend0);
         c
+    }
+
+    /// The landing foot's mean ankle rate dθ5/dt over the first `window` s of its heel rocker
+    /// (at most [`EARLY`]), rad/s: the last step's swing foot lands into it (see
+    /// [`super::swing::SwingFoot::theta5_rate_hs`]), as every step's lands into the next
+    /// step's heel rocker.
+    pub fn contact_ankle_rate(&self, window: f64) -> f64 {
+        let s = &self.stance_theta5;
+        let (Some(&a), Some(&b)) = (
+            s.first(),
+            s.iter().take_while(|x| x.0 <= window + 1e-9).last(),
+        ) else {
+            return 0.0;
+        };
+        if b.0 > a.0 {
+            (b.1 - a.1) / (b.0 - a.0)
+        } else {
+            0.0
+        }
     }
 
     /// Pelvis centre (dynamic hip x, y) and lateral position at `t`.
