@@ -283,6 +283,16 @@ const MIN_TRAVEL: f64 = 0.3;
 /// enough that this binds only marginally (1 km/h).
 const LIFT_PER_TRAVEL: f64 = 0.25;
 
+/// Speed below which the ankle curve's lift stops growing as 1/speed, m/s (3 km/h; was
+/// 0.5 m/s). At 1 km/h the lift was 5.7 cm (the travel cap) on a 23 cm travel, and near the end of
+/// swing1 the slaved ankle raced down the curve's steep far flank: knee rate 1.8 → −8.4 →
+/// 1.3 rad/s within 50 ms, ankle 1.5 → 4.9 → 1.6 m/s (knee continuity ratio 6.5 every swing).
+/// With 4.2 cm that is gone (1 km/h 1.8 m: offenders > 5 from 16 to 8, none in swing1; 2 km/h
+/// 1.5 m: 22 to 6), and walks from 3 km/h up are unchanged. A tighter travel cap (0.15) did the
+/// same for steady walks but broke the first half step from standing (ratios > 1000). The
+/// swing1 clearance rounds still raise the curve where the toe needs it.
+const LIFT_SPEED_MIN: f64 = 3.0 / 3.6;
+
 impl SwingSpec<'_> {
     /// The kinematic swing foot of this swing.
     pub fn swing_foot(&self) -> SwingFoot {
@@ -405,7 +415,7 @@ impl SwingSpec<'_> {
             ));
         }
         let a_min = a1[1] + extra_lift;
-        let lift = (self.ankle_lift / speed.max(0.5)).min(LIFT_PER_TRAVEL * d);
+        let lift = (self.ankle_lift / speed.max(LIFT_SPEED_MIN)).min(LIFT_PER_TRAVEL * d);
         let a_max = a0[1].max(a_min) + lift;
         AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
             .ok_or_else(|| "ankle curve is singular".to_string())
