@@ -113,35 +113,15 @@ fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
         }];
         let (m, _) = generate_walk(&schedule, &WalkOptions::default()).unwrap();
         let fps = m.fps();
-        let mut worst: f64 = 0.0;
-        let mut checked = 0;
-        for e in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
-            // Frame f is the first at or after the contact; skip contacts without 4 frames of
-            // swing before them (the walk's first frame) or 4 frames of stance after.
-            let f = (e.time_s * fps - 1e-9).ceil() as usize;
-            if f < 5 || f + 5 >= m.len() {
-                continue;
-            }
-            let ankle = Joint::leg(e.side)[2];
-            let s = joint_steps(&m, ankle);
+        for (f, side) in contact_frames(&m) {
             // s[f − 2] is the last full frame before the contact.
-            let pre = s[f - 2] * fps;
+            let pre = joint_steps(&m, Joint::leg(side)[2])[f - 2] * fps;
             assert!(
                 pre > 0.3 * rate && pre < 1.35 * rate,
                 "{kmh} km/h, contact at frame {f}: ankle rate before contact {pre:.2} rad/s"
             );
-            for i in f - 3..=f + 2 {
-                let mut nb: Vec<f64> = s[i - 3..i]
-                    .iter()
-                    .chain(&s[i + 1..i + 4])
-                    .copied()
-                    .collect();
-                nb.sort_by(f64::total_cmp);
-                let med = 0.5 * (nb[2] + nb[3]);
-                worst = worst.max(s[i] / med.max(1e-3));
-            }
-            checked += 1;
         }
+        let (worst, checked) = contact_ratio(&m, |s| Joint::leg(s)[2]);
         assert!(checked >= 6, "{kmh} km/h: {checked} contacts checked");
         println!("{kmh} km/h: worst ankle ratio over the contacts {worst:.2} (bound {bound})");
         assert!(
@@ -249,21 +229,28 @@ fn the_start_and_the_stop_do_not_regress() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// Worst continuity ratio of `joint_of(side)` within ± 3 frames of the walk's heel strikes (those
-/// with 4 frames before and after), and the number of contacts examined.
+/// Heel strikes with 4 frames of swing before and 4 of stance after (so not the walk's first
+/// frame): the first frame at or after each contact, and its side.
+fn contact_frames(m: &gaitfit::generator::motion::Motion) -> Vec<(usize, gaitfit::events::Side)> {
+    let fps = m.fps();
+    m.events
+        .iter()
+        .filter(|e| e.kind == EventKind::HeelStrike)
+        .map(|e| ((e.time_s * fps - 1e-9).ceil() as usize, e.side))
+        .filter(|&(f, _)| f >= 5 && f + 5 < m.len())
+        .collect()
+}
+
+/// Worst continuity ratio of `joint_of(side)` within ± 3 frames of the walk's heel strikes
+/// ([`contact_frames`]), and the number of contacts examined.
 fn contact_ratio(
     m: &gaitfit::generator::motion::Motion,
     joint_of: impl Fn(gaitfit::events::Side) -> Joint,
 ) -> (f64, usize) {
-    let fps = m.fps();
     let mut worst: f64 = 0.0;
-    let mut checked = 0;
-    for e in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
-        let f = (e.time_s * fps - 1e-9).ceil() as usize;
-        if f < 5 || f + 5 >= m.len() {
-            continue;
-        }
-        let s = joint_steps(m, joint_of(e.side));
+    let contacts = contact_frames(m);
+    for &(f, side) in &contacts {
+        let s = joint_steps(m, joint_of(side));
         for i in f - 3..=f + 2 {
             let mut nb: Vec<f64> = s[i - 3..i]
                 .iter()
@@ -273,9 +260,8 @@ fn contact_ratio(
             nb.sort_by(f64::total_cmp);
             worst = worst.max(s[i] / (0.5 * (nb[2] + nb[3])).max(1e-3));
         }
-        checked += 1;
     }
-    (worst, checked)
+    (worst, contacts.len())
 }
 
 /// Slow walks: the stance knee leaves heel strike from rest (C¹ with the swing's locked knee;

@@ -1202,24 +1202,7 @@ mod tests {
     fn landing_roll_puts_the_straight_leg_in_reach_with_the_heel_down() {
         let body = Body::from_height(1.8, 75.0).unwrap();
         let foot = FootShape::new(&body);
-        let leg = VirtualLeg {
-            foot,
-            l3: body.l3,
-            l4: body.l4,
-            flat_ankle: [0.0, body.l9],
-            theta5_max: 100f64.to_radians(),
-            theta6_max: 30f64.to_radians(),
-            knee_toe_off: 35f64.to_radians(),
-            toe_off_time: 1.0,
-            min_knee_blend: 0.0,
-            period: FootPeriod::HeelRocker,
-            rho: -0.3,
-            meta_start: None,
-            transitions: [None; 3],
-            rocker: None,
-            knee_soft: super::super::virtual_leg::KNEE_SOFT,
-            slow_knee_start: true,
-        };
+        let leg = super::super::virtual_leg::test_leg(&body, FootPeriod::HeelRocker, -0.3);
         let l1 = body.l3 + body.l4;
         let dist = |r: f64, hip: [f64; 2], dz: f64| {
             let p = leg.pose_at(hip, dz, r);

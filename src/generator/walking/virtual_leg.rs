@@ -671,31 +671,36 @@ impl VirtualLeg {
     }
 }
 
+/// Test fixture: `body`'s virtual leg (θ5max 100°, θ6max 30°, knee at toe off 35°) in
+/// `period` at roll `rho`, nothing planned yet.
+#[cfg(test)]
+pub(crate) fn test_leg(body: &super::body::Body, period: FootPeriod, rho: f64) -> VirtualLeg {
+    VirtualLeg {
+        foot: FootShape::new(body),
+        l3: body.l3,
+        l4: body.l4,
+        flat_ankle: [0.0, body.l9],
+        theta5_max: 100f64.to_radians(),
+        theta6_max: 30f64.to_radians(),
+        knee_toe_off: 35f64.to_radians(),
+        toe_off_time: 1.0,
+        min_knee_blend: 0.0,
+        period,
+        rho,
+        meta_start: None,
+        transitions: [None; 3],
+        rocker: None,
+        knee_soft: KNEE_SOFT,
+        slow_knee_start: true,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::body::Body;
     use super::*;
 
-    fn leg(body: &Body, period: FootPeriod, rho: f64) -> VirtualLeg {
-        VirtualLeg {
-            foot: FootShape::new(body),
-            l3: body.l3,
-            l4: body.l4,
-            flat_ankle: [0.0, body.l9],
-            theta5_max: 100f64.to_radians(),
-            theta6_max: 30f64.to_radians(),
-            knee_toe_off: 35f64.to_radians(),
-            toe_off_time: 1.0,
-            min_knee_blend: 0.0,
-            period,
-            rho,
-            meta_start: None,
-            transitions: [None; 3],
-            rocker: None,
-            knee_soft: KNEE_SOFT,
-            slow_knee_start: true,
-        }
-    }
+    use super::test_leg as leg;
 
     /// A hip that lands behind the foot with the straight leg reaching the pitched ankle, then
     /// moves forward and down (as KLAW's does after the collision): the flat foot comes within
