@@ -19,7 +19,9 @@
 //!    — at least its unloaded length `l1` and lengthening — it is locked (`ẇ = 0`; the locking
 //!    impulse acts along the leg, so the generalized momenta of `θ1` and `θ2` are conserved).
 //!    A leg that regains `l1` from below locks at `l1`; one that landed longer than `l1` and
-//!    bottoms out above it locks where it turns.
+//!    bottoms out above it locks where it turns. The dynamics lock in one instant; the recorded
+//!    motion (what the body is drawn from) spreads that rate jump over ±[`LOCK_BLEND`]
+//!    ([`blend_rate_jump`]), so the drawn leg decelerates to the lock instead of jolting.
 //! 3. *extension* (telescopic): from the event `θ1 > 0` (leg passes the vertical) the lock is
 //!    removed with `pa` set so that `F_w` equals the leg's reaction (no jump in force), and `pa`
 //!    grows as `pa_u + P·τ²` (τ the fraction of the remaining time) to extend the leg — plantar
@@ -29,9 +31,64 @@
 //! here the shooting makes it reach that length exactly at the end, so that lock never engages
 //! and is not implemented.
 use super::dynamics::{solve2, StanceModel};
+use super::foot::smoothstep;
 use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_2d, Solved};
 use super::track::{Node, Track};
+
+/// Half-width of the kinematic blend that spreads the lock's rate jump, s (the leg is drawn
+/// decelerating to the lock over 2 × 20 ms).
+pub const LOCK_BLEND: f64 = 0.02;
+
+/// Spreads the rate jump of a recorded track at `t_jump` (a node pair at that time: before and
+/// after) over `[t_jump − half, t_jump + half]`: each coordinate gets the compact correction
+/// `c = Δ (R(s) − max(s, 0))`, `Δ` its rate jump, `R` the integral of a smoothstep rising from 0
+/// to 1 across the window (so `R(±half)` equals the hinge, `c` vanishes outside, and `q + c` is
+/// C² there and C¹ at `t_jump`).
+///
+/// Why: the lock stops the telescopic leg's lengthening (0.15–0.25 m/s) in one instant, and the
+/// virtual leg drawn on it — nearly straight at that moment, knee rate ∝ ẇ/θ4 — turned that into
+/// a knee-rate spike (continuity ratios 6–23 at heel off at 1–2 km/h, 12 at toe off at 5 km/h
+/// × 1.5 m) and a jolt of the trunk and arms. The dynamics keep their ideal lock (the paper's
+/// rigid subphase; the shooting's end state is untouched, as the window ends before `t_step`):
+/// only the recorded motion — what the body and the swing leg's hip are drawn from — is
+/// blended. With `Δ = −ẇ` the drawn leg is never longer than the simulated one (at most
+/// `3·half·|ẇ|/16` shorter, ≈ 0.8 mm), so the virtual leg always reaches its ankle.
+pub fn blend_rate_jump<const N: usize>(track: &mut Track<N>, t_jump: f64, half: f64) {
+    if half <= 0.0 {
+        return;
+    }
+    let Some(k) = track
+        .nodes
+        .windows(2)
+        .position(|w| w[0].t == t_jump && w[1].t == t_jump)
+    else {
+        return;
+    };
+    let (before, after) = (track.nodes[k], track.nodes[k + 1]);
+    let mut jump = [0.0; N];
+    for (i, d) in jump.iter_mut().enumerate() {
+        *d = after.qd[i] - before.qd[i];
+    }
+    for (j, n) in track.nodes.iter_mut().enumerate() {
+        let s = n.t - t_jump;
+        if s.abs() >= half {
+            continue;
+        }
+        // The pre-jump node of the pair sits at s = 0 on the left branch of the hinge.
+        let right = j > k || (s > 0.0);
+        let u = (s + half) / (2.0 * half);
+        let r = 2.0 * half * u * u * u * (1.0 - 0.5 * u);
+        let r1 = smoothstep(u);
+        let r2 = 6.0 * u * (1.0 - u) / (2.0 * half);
+        let (hinge, hinge1) = if right { (s, 1.0) } else { (0.0, 0.0) };
+        for (i, d) in jump.iter().enumerate() {
+            n.q[i] += d * (r - hinge);
+            n.qd[i] += d * (r1 - hinge1);
+            n.qdd[i] += d * r2;
+        }
+    }
+}
 
 /// Everything that defines one stance phase except its two shooting unknowns.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -273,6 +330,10 @@ impl StanceSpec {
         }
         if record {
             track.push(node(self, t, &y, sub, ext, f1));
+            if let Some(t_lock) = lock_time {
+                let half = LOCK_BLEND.min(t_lock).min(self.duration - t_lock);
+                blend_rate_jump(&mut track, t_lock, half);
+            }
         }
         StanceRun {
             end: [y[0], y[1], y[2], y[3], y[4], y[5]],
@@ -396,6 +457,94 @@ mod tests {
         assert!(worst[0] < 2e-3 && worst[1] < 5e-4, "jumps {worst:?}");
         // The scan crosses the graze.
         assert!(above > 0 && at > 0, "locked above l1 {above}, at l1 {at}");
+    }
+
+    #[test]
+    fn the_lock_is_drawn_decelerating_over_the_blend() {
+        // A leg lengthening at v that locks at t = 0.5 s (nodes every 2 ms, a pair at the lock).
+        let (v, t_lock, half) = (0.2, 0.5, LOCK_BLEND);
+        let mut tr = Track::<1>::default();
+        for k in 0..=500 {
+            let t = 0.002 * k as f64;
+            let before = t <= t_lock;
+            let n = |locked: bool| Node {
+                t,
+                q: [v * t.min(t_lock)],
+                qd: [if locked { 0.0 } else { v }],
+                qdd: [0.0],
+            };
+            tr.push(n(!before));
+            if k == 250 {
+                tr.push(n(true));
+            }
+        }
+        let raw = tr.clone();
+        blend_rate_jump(&mut tr, t_lock, half);
+        // Independent: the drawn rate is v (1 − smoothstep) across the window; the position
+        // its integral, never beyond the lock and at most 3·half·v/16 short of it.
+        let mut worst = [0.0f64; 2];
+        for k in 0..=4000 {
+            let t = 0.40 + 0.00005 * k as f64;
+            let (q, qd, _) = tr.at(t);
+            let (q_raw, _, _) = raw.at(t);
+            let u = ((t - t_lock + half) / (2.0 * half)).clamp(0.0, 1.0);
+            let rate = v * (1.0 - u * u * (3.0 - 2.0 * u));
+            worst[0] = worst[0].max((qd[0] - rate).abs());
+            assert!(q[0] <= q_raw[0] + 1e-12, "longer than simulated at {t}");
+            worst[1] = worst[1].max(q_raw[0] - q[0]);
+            if (t - t_lock).abs() >= half {
+                assert!(
+                    (q[0] - q_raw[0]).abs() < 1e-12,
+                    "changed outside the blend at {t}"
+                );
+            }
+        }
+        assert!(worst[0] < 1e-6, "rate off by {}", worst[0]);
+        assert!(
+            (worst[1] - 3.0 * half * v / 16.0).abs() < 1e-6,
+            "{}",
+            worst[1]
+        );
+        let k = tr.nodes.iter().position(|n| n.t == t_lock).unwrap();
+        let (a, b) = (tr.nodes[k], tr.nodes[k + 1]);
+        assert!(a.q[0] == b.q[0] && (a.qd[0] - b.qd[0]).abs() < 1e-12 && a.qd[0] > 0.0);
+    }
+
+    #[test]
+    fn a_recorded_stance_is_c1_at_the_lock_and_ends_where_the_simulated_one_does() {
+        let (spec, start) = grazing_spec();
+        let h = spec.step(&start);
+        // Step torques where the compression regains l1 from below (a real rate jump).
+        let mut seen = 0;
+        for i in 0..=50 {
+            let a = 74.0 + 0.1 * i as f64;
+            let drawn = spec.run(&start, a, 0.0, h, true);
+            let sim = spec.run(&start, a, 0.0, h, false);
+            assert_eq!(drawn.end, sim.end);
+            let lock = drawn.lock_time.expect("locked");
+            let k = drawn.track.nodes.iter().position(|n| n.t == lock).unwrap();
+            let (b, c) = (drawn.track.nodes[k], drawn.track.nodes[k + 1]);
+            for j in 0..3 {
+                assert!(
+                    (b.qd[j] - c.qd[j]).abs() < 1e-12,
+                    "rate jump in {j} at {lock}"
+                );
+            }
+            // Regained l1 from below: the simulated leg stops at the lock, the drawn one is
+            // halfway down from its lengthening rate there, and at rest by the blend's end.
+            if b.qd[0] > 1e-4 {
+                seen += 1;
+                let ext = drawn.extend_time.unwrap_or(spec.duration);
+                if ext > lock + LOCK_BLEND {
+                    let after = drawn.track.at(lock + LOCK_BLEND).1[0];
+                    assert!(
+                        after.abs() < 1e-6,
+                        "still moving {after} at the blend's end"
+                    );
+                }
+            }
+        }
+        assert!(seen > 0, "no lock from below");
     }
 
     #[test]
