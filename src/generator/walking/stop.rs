@@ -338,7 +338,7 @@ impl Closing {
     }
 
     /// The landing foot's mean ankle rate dθ5/dt over the first `window` s of its heel rocker
-    /// (at most [`EARLY`]), rad/s: the last step's swing foot lands into it (see
+    /// (at most `EARLY`, 0.05 s), rad/s: the last step's swing foot lands into it (see
     /// [`super::swing::SwingFoot::theta5_rate_hs`]), as every step's lands into the next
     /// step's heel rocker.
     pub fn contact_ankle_rate(&self, window: f64) -> f64 {
