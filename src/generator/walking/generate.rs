@@ -388,6 +388,7 @@ pub fn generate_steps(
         rocker: None,
         knee_soft: super::virtual_leg::KNEE_SOFT,
         slow_knee_start: true,
+        knee_ease: None,
     };
     let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
     let mut trailing_clock = 0.0;

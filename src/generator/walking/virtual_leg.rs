@@ -25,6 +25,27 @@ use std::f64::consts::FRAC_PI_2;
 /// Width of the knee's soft straightening in late stance, m.
 pub const KNEE_SOFT: f64 = 0.0015;
 
+/// Time constant of the knee's eased straightening after foot flat, s.
+///
+/// Why: in slow walks (1–2 km/h) the hip never comes much below the straight leg, so the planned
+/// heel rocker lands the foot with the knee still flexing (up to 0.034 rad/frame at 1 km/h ×
+/// 1.5 m) at the shortest point of its pass; the flat-foot and heel-off rules then straighten
+/// the knee as the hip–ankle distance grows, and near straight (θ4 ∝ √(l1 − d)) that took the
+/// knee from flexing to straightening at 0.011–0.025 rad/frame within 1–2 frames and back to
+/// rest within 3–4 (continuity ratios 6–8.5 on the knee at heel off). The knee instead follows
+/// the rule's knee from above as a critically damped second-order system with this time
+/// constant: never less flexed than the rule (a more flexed knee only asks the foot to roll
+/// a little earlier, so the ankle stays in reach), C¹ through its peak and its return to rest.
+pub const KNEE_EASE: f64 = 0.015;
+
+/// The knee is eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
+/// margin ([`VirtualLeg::knee_soft`]) below this, m: a landing within 0.33 mm of the straight
+/// leg. Measured (8 steps): 1 km/h lands at 0.04–0.30 mm, 2 km/h at 0.41–0.67 mm after its
+/// first step, 3 km/h and faster at the full [`KNEE_SOFT`]. Easing every leg made the heel
+/// start rising from rest at speed at 3 km/h (ratios 3.8 → 7.1–8.6) and 2 km/h × 2.0 m's
+/// elbows worse (6.0 → 7.3); above this threshold their rules' knees are smooth already.
+pub const KNEE_EASE_SOFT: f64 = 0.00033;
+
 /// How far the foot may roll about the toe tip beyond the toe-bend limit, rad (80°).
 const RHO_CAP: f64 = 1.4;
 
@@ -105,6 +126,10 @@ pub struct VirtualLeg {
     /// rest, in slow walks (see [`VirtualLeg::plan_heel_rocker`]). The walk's steps do; the
     /// stop's landing does not (measured worse there: 3 km/h 2.9 → 4.0, 5 km/h 6.0 → 7.8).
     pub slow_knee_start: bool,
+    /// State of the knee's eased straightening (see [`KNEE_EASE`]): time, knee flexion and its
+    /// rate at the last flat / heel-off sample, and the rule's knee then. `None` before the
+    /// foot is flat.
+    pub knee_ease: Option<[f64; 4]>,
 }
 
 /// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
@@ -558,6 +583,39 @@ impl VirtualLeg {
         false
     }
 
+    /// The leg length of the knee eased toward the rule's (`d_rule`) at time `t`, never longer
+    /// than it (see [`KNEE_EASE`]): the exact critically damped step from the last sample's
+    /// knee and rate toward the rule's knee; where the rule's knee is the more flexed, the knee
+    /// takes it and its rate.
+    fn eased_span(&mut self, t: f64, d_rule: f64) -> f64 {
+        let (l3, l4) = (self.l3, self.l4);
+        let k_rule = knee_for(l3, l4, d_rule);
+        let (k, kd) = match self.knee_ease {
+            Some([t0, k0, kd0, kr0]) if t > t0 => {
+                let h = t - t0;
+                let w = 1.0 / KNEE_EASE;
+                let e = k0 - k_rule;
+                let c = kd0 + w * e;
+                let decay = (-w * h).exp();
+                let k1 = k_rule + (e + c * h) * decay;
+                let kd1 = (kd0 - w * c * h) * decay;
+                if k1 <= k_rule {
+                    (k_rule, (k_rule - kr0) / h)
+                } else {
+                    (k1, kd1)
+                }
+            }
+            Some([_, k0, kd0, _]) => (k0.max(k_rule), kd0),
+            None => (k_rule, 0.0),
+        };
+        self.knee_ease = Some([t, k, kd, k_rule]);
+        if k > k_rule {
+            span_for(l3, l4, k).min(d_rule)
+        } else {
+            d_rule
+        }
+    }
+
     /// Advances the rules to time `t` (leg clock) with the hip at `hip` and lateral offset `dz`
     /// and returns the configuration. Calls must come in time order.
     pub fn advance(&mut self, t: f64, hip: [f64; 2], dz: f64) -> LegPose {
@@ -617,6 +675,12 @@ impl VirtualLeg {
                 l1 - sigma
             } else {
                 d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
+            };
+            // Only where the planned rocker landed nearly straight (see `KNEE_EASE_SOFT`).
+            let d_t = if self.knee_soft < KNEE_EASE_SOFT {
+                self.eased_span(t, d_t)
+            } else {
+                d_t
             };
             let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip) + l1 - d_t;
             let lo = self.rho.max(0.0);
@@ -692,6 +756,7 @@ pub(crate) fn test_leg(body: &super::body::Body, period: FootPeriod, rho: f64) -
         rocker: None,
         knee_soft: KNEE_SOFT,
         slow_knee_start: true,
+        knee_ease: None,
     }
 }
 
@@ -868,5 +933,44 @@ mod tests {
         let after = worst_step_ratio(&frames(&s[from..]), floor);
         assert!(before > 5.0, "the rule's kick: {before}");
         assert!(after < 3.0, "smoothed: {after}");
+    }
+
+    #[test]
+    fn eased_knee_peaks_and_settles_c1_and_never_straighter_than_the_rule() {
+        // The rule's knee as at 1 km/h heel off: flexing at 1.5 rad/s up to a sharp peak at
+        // 0.1 s, straightening at 1.2 rad/s, then at rest at 0.02 rad (kinks at both ends).
+        let body = Body::from_height(1.8, 75.0).unwrap();
+        let mut leg = test_leg(&body, FootPeriod::Flat, 0.0);
+        let (l3, l4) = (leg.l3, leg.l4);
+        let rule = |t: f64| {
+            if t <= 0.1 {
+                0.02 + 1.5 * t
+            } else {
+                (0.17 - 1.2 * (t - 0.1)).max(0.02)
+            }
+        };
+        let h = 0.002;
+        let mut knees = Vec::new();
+        for i in 0..=200 {
+            let t = h * i as f64;
+            let d_rule = span_for(l3, l4, rule(t));
+            let d = leg.eased_span(t, d_rule);
+            assert!(d <= d_rule + 1e-12, "longer than the rule at {t}");
+            knees.push(knee_for(l3, l4, d));
+        }
+        let rates: Vec<f64> = knees.windows(2).map(|w| (w[1] - w[0]) / h).collect();
+        let worst_change = rates
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        // The rule's rate changes by 2.7 rad/s within one sample at the peak; the eased knee's
+        // by at most h/τ of it per sample (C¹, second-order lag).
+        assert!(worst_change < 0.6, "rate change per sample {worst_change}");
+        // It peaks after the rule (flexing on briefly) and settles on the rule at rest.
+        let peak = (0..knees.len())
+            .max_by(|&a, &b| knees[a].total_cmp(&knees[b]))
+            .unwrap_or(0);
+        assert!(peak as f64 * h > 0.1 && knees[peak] > 0.17);
+        assert!((knees[200] - 0.02).abs() < 1e-3, "{}", knees[200]);
     }
 }
