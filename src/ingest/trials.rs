@@ -566,11 +566,7 @@ impl Builder {
             self.columns = vec![None; N_QUANTITIES];
         }
         let n = self.subject.len();
-        self.subject.push(self.subjects.get(subject.as_bytes()));
-        self.source.push(self.sources.get(source.as_bytes()));
-        self.trial.push(self.trials.get(trial.as_bytes()));
-        self.gait.push(gait);
-        self.side.push(side);
+        self.push_keys(subject, gait, side, source, trial);
         for ((col, &v), &p) in self.columns.iter_mut().zip(&vals.0).zip(present) {
             if !p {
                 continue;
@@ -593,6 +589,22 @@ impl Builder {
         }
     }
 
+    /// A row's keys: subject, source and trial interned, gait and side as given.
+    fn push_keys(
+        &mut self,
+        subject: &str,
+        gait: Option<Gait>,
+        side: Option<Side>,
+        source: &str,
+        trial: &str,
+    ) {
+        self.subject.push(self.subjects.get(subject.as_bytes()));
+        self.source.push(self.sources.get(source.as_bytes()));
+        self.trial.push(self.trials.get(trial.as_bytes()));
+        self.gait.push(gait);
+        self.side.push(side);
+    }
+
     /// [`Builder::push`] for a parsed file's rows, after [`Builder::reserve`]: every column the
     /// file has (`present`, the quantities' indices) already exists, so a row is one push per
     /// column.
@@ -607,11 +619,7 @@ impl Builder {
         vals: &FieldValues,
         present: &[usize],
     ) {
-        self.subject.push(self.subjects.get(subject.as_bytes()));
-        self.source.push(self.sources.get(source.as_bytes()));
-        self.trial.push(self.trials.get(trial.as_bytes()));
-        self.gait.push(gait);
-        self.side.push(side);
+        self.push_keys(subject, gait, side, source, trial);
         for &q in present {
             if let Some(c) = &mut self.columns[q] {
                 c.push(vals.0[q]);

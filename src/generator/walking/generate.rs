@@ -371,24 +371,8 @@ pub fn generate_steps(
         };
     }
     // The trailing leg's virtual-leg state.
-    let mk_leg = |flat_x: f64, period: FootPeriod, rho: f64| VirtualLeg {
-        foot,
-        l3: body.l3,
-        l4: body.l4,
-        flat_ankle: [flat_x, body.l9],
-        theta5_max: a.ankle_dorsiflexion_max_deg.to_radians(),
-        theta6_max: a.metatarsal_max_deg.to_radians(),
-        knee_toe_off: a.knee_toe_off_deg.to_radians(),
-        toe_off_time: 0.0,
-        min_knee_blend: 0.0,
-        period,
-        rho,
-        meta_start: None,
-        transitions: [None; 3],
-        rocker: None,
-        knee_soft: super::virtual_leg::KNEE_SOFT,
-        slow_knee_start: true,
-        knee_ease: None,
+    let mk_leg = |flat_x: f64, period: FootPeriod, rho: f64| {
+        VirtualLeg::new(foot, &body, a, flat_x, period, rho)
     };
     let mut trailing = mk_leg(ankle_x[idx(stance_side.opposite())], FootPeriod::Flat, 0.0);
     let mut trailing_clock = 0.0;

@@ -19,6 +19,8 @@
 //! ([`FootShape::rolled`]); `ρ` never decreases after the foot is flat. Distances are measured in
 //! three dimensions (the hip's lateral offset from the foot, `dz`, is included), so the leg drawn
 //! in 3D reaches its ankle exactly.
+use super::attributes::WalkAttributes;
+use super::body::Body;
 use super::foot::{smoothstep, toe_blend, FootShape};
 use std::f64::consts::FRAC_PI_2;
 
@@ -370,6 +372,38 @@ fn root_nonpositive_side(g: &impl Fn(f64) -> f64, pos: f64, neg: f64) -> f64 {
 }
 
 impl VirtualLeg {
+    /// A leg of `body` with its foot flat at `flat_x` (ankle at the flat foot's height `l9`), the
+    /// foot limits of the attributes (θ5max, θ6max, knee at toe-off), in `period` at roll `rho`,
+    /// and nothing planned or recorded yet (no toe-off time, rocker, transitions or knee ease).
+    pub fn new(
+        foot: FootShape,
+        body: &Body,
+        a: &WalkAttributes,
+        flat_x: f64,
+        period: FootPeriod,
+        rho: f64,
+    ) -> VirtualLeg {
+        VirtualLeg {
+            foot,
+            l3: body.l3,
+            l4: body.l4,
+            flat_ankle: [flat_x, body.l9],
+            theta5_max: a.ankle_dorsiflexion_max_deg.to_radians(),
+            theta6_max: a.metatarsal_max_deg.to_radians(),
+            knee_toe_off: a.knee_toe_off_deg.to_radians(),
+            toe_off_time: 0.0,
+            min_knee_blend: 0.0,
+            period,
+            rho,
+            meta_start: None,
+            transitions: [None; 3],
+            rocker: None,
+            knee_soft: KNEE_SOFT,
+            slow_knee_start: true,
+            knee_ease: None,
+        }
+    }
+
     /// Evaluates the leg for the hip at `hip` (x, y) with lateral offset `dz` for roll `rho`.
     pub fn pose_at(&self, hip: [f64; 2], dz: f64, rho: f64) -> LegPose {
         let (ankle, pitch, toe_bend) = self.foot.rolled(self.flat_ankle, rho, self.theta6_max);
@@ -735,34 +769,24 @@ impl VirtualLeg {
     }
 }
 
-/// Test fixture: `body`'s virtual leg (θ5max 100°, θ6max 30°, knee at toe off 35°) in
-/// `period` at roll `rho`, nothing planned yet.
+/// Test fixture: `body`'s virtual leg with the default attributes (θ5max 100°, θ6max 30°, knee
+/// at toe off 35°) in `period` at roll `rho`, toe-off at 1 s, nothing planned yet.
 #[cfg(test)]
-pub(crate) fn test_leg(body: &super::body::Body, period: FootPeriod, rho: f64) -> VirtualLeg {
-    VirtualLeg {
-        foot: FootShape::new(body),
-        l3: body.l3,
-        l4: body.l4,
-        flat_ankle: [0.0, body.l9],
-        theta5_max: 100f64.to_radians(),
-        theta6_max: 30f64.to_radians(),
-        knee_toe_off: 35f64.to_radians(),
-        toe_off_time: 1.0,
-        min_knee_blend: 0.0,
+pub(crate) fn test_leg(body: &Body, period: FootPeriod, rho: f64) -> VirtualLeg {
+    let mut leg = VirtualLeg::new(
+        FootShape::new(body),
+        body,
+        &WalkAttributes::default(),
+        0.0,
         period,
         rho,
-        meta_start: None,
-        transitions: [None; 3],
-        rocker: None,
-        knee_soft: KNEE_SOFT,
-        slow_knee_start: true,
-        knee_ease: None,
-    }
+    );
+    leg.toe_off_time = 1.0;
+    leg
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::body::Body;
     use super::*;
 
     use super::test_leg as leg;
