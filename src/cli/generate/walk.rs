@@ -44,7 +44,7 @@ pub struct Args {
     /// Frames per second of the output.
     #[arg(long, default_value_t = 100.0)]
     pub fps: f64,
-    /// Start standing (the first step is a half step from rest).
+    /// Start standing, feet side by side (the first step starts from rest).
     #[arg(long = "from-rest")]
     pub from_rest: bool,
     /// End standing: a last half step, then the trailing foot is brought alongside and the body

@@ -36,7 +36,8 @@ pub struct WalkOptions {
     pub relations: WalkRelations,
     /// Output frame rate, frames/s.
     pub fps: f64,
-    /// Start from standing (the first step is a half step from rest).
+    /// Start from standing, feet side by side: the first step starts from rest (its swing foot
+    /// travels one step length, half a stride).
     pub start_from_rest: bool,
     /// End standing: a last half step, then the trailing foot is brought alongside and the body
     /// comes to rest ([`super::stop`]).
@@ -297,6 +298,18 @@ const CONTACT_RATE_WINDOW: f64 = 0.01;
 /// below 2° (human ankles plantarflex at a few rad/s through loading response).
 pub const MAX_CONTACT_ANKLE_RATE: f64 = 3.0;
 
+/// How much later (fraction of the swing) swing1 ends in the last step before a stop, a half
+/// step whose swing foot travels 1.5 step lengths to a heel strike only half a step ahead.
+///
+/// Near the end of swing1 its ankle curve falls about as steeply as the circle the ankle can
+/// reach about the knee, and the slaved knee slid the ankle down the curve's far flank at up to
+/// 5.6 m/s (the standing-start schedule 2 → 5 → 3 km/h at 1.8 m: knee ratio 10.9 three frames
+/// before t1, once the first step no longer carried its curve lift into every later swing).
+/// Measured, not derived: ends at 50/55/58/60 % of the swing gave that swing's ankle peak/mean
+/// speed at 2 km/h 5.95/6.17/4.97/4.74 and the schedule's worst ratio 10.9/7.2/7.2/7.2, but the
+/// 7 km/h × 1.8 m stop's heel landing 4.7/5.5/5.8/7.0; 40 % was worse everywhere.
+const STOP_SWING1_DELAY: f64 = 0.05;
+
 /// Unrecorded steps simulated before a steady (not from rest) start.
 pub const PRE_ROLL: usize = 1;
 
@@ -488,6 +501,26 @@ pub fn generate_steps(
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
         let zf_w = side_z(swing_side, a);
+        // From standing, the second step's trailing leg (the first stance leg) stood flat or
+        // barely heeled off through the first step — the hip, starting at rest, never gets far
+        // enough ahead for the heel-off rule to roll it onto its toes — so it left the ground
+        // nearly flat with the knee almost straight, its shank vertical: swing1's slaved knee
+        // then lifted the ankle 12 cm almost straight up (2 km/h) and the knee switched to the
+        // ankle curve's other branch (7.5 cm in one frame). As at every other toe off, it now
+        // rolls onto its toes through the double support while the knee flexes to its toe-off
+        // value (the meta-off rule from the double support's start): the heel rises, the shank
+        // inclines, and the swing leaves as a steady one does (ankle peak/mean speed 4.3 → 2.3
+        // at 1 km/h). Not the first step's trailing leg: rolled from standing at 1 km/h, its short
+        // steep start put swing1's slaved knee on the curve's other branch at once (ratios
+        // 200–600).
+        if opt.start_from_rest && kk == 1 && trailing.period != FootPeriod::MetaOff {
+            let (hp, hz) = swing_hip3(0.0);
+            let knee = trailing.pose_at(hp, hz - zf_w, trailing.rho).knee;
+            trailing.period = FootPeriod::MetaOff;
+            trailing.meta_start = Some((trailing_clock, knee));
+            trailing.transitions[1].get_or_insert(trailing_clock);
+            trailing.transitions[2] = Some(trailing_clock);
+        }
         let mut trail_poses: Vec<(f64, LegPose, [f64; 2])> = Vec::with_capacity(n_v + 1);
         for i in 0..=n_v {
             let t = t_ds * i as f64 / n_v as f64;
@@ -567,7 +600,12 @@ pub fn generate_steps(
         // 4. Swing.
         let t0 = t_ds;
         let tsw = times.swing;
-        let swing_times = [t0, t0 + a.swing1_end * tsw, t0 + a.swing2_end * tsw, t_step];
+        let swing1_end = if to_rest {
+            (a.swing1_end + STOP_SWING1_DELAY).min(0.5 * (a.swing1_end + a.swing2_end))
+        } else {
+            a.swing1_end
+        };
+        let swing_times = [t0, t0 + swing1_end * tsw, t0 + a.swing2_end * tsw, t_step];
         let breakpoints = st_run.track.breakpoints();
         let hip_fn = &swing_hip;
         let sspec = SwingSpec {

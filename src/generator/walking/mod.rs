@@ -84,9 +84,11 @@ pub fn steps_for_duration(
 }
 
 /// Generates a walk: the schedule's stretches one after the other, with accelerations and
-/// decelerations at one-step granularity (§2.4). With `opts.start_from_rest` the first step is
-/// a half step from standing; with `opts.stop` the last step is a half step, after which the
-/// trailing foot is brought alongside and the body comes to rest ([`stop`]).
+/// decelerations at one-step granularity (§2.4). With `opts.start_from_rest` the first step
+/// starts from standing, feet side by side, and keeps its commanded step length (its swing foot
+/// travels one step length, half a stride; the hip, starting at rest, half a step); with
+/// `opts.stop` the last step is a half step, after which the trailing foot is brought alongside
+/// and the body comes to rest ([`stop`]).
 pub fn generate_walk(
     schedule: &[ScheduleEntry],
     opts: &WalkOptions,
@@ -115,12 +117,15 @@ pub fn generate_walk(
             message: "the walk has no steps; give a duration or a schedule with steps".into(),
         });
     }
-    if opts.start_from_rest {
-        // A half step from standing, at the same step frequency.
-        let f = &mut steps[0];
-        f.step_length_m *= 0.5;
-        f.speed_m_per_s *= 0.5;
-    }
+    // From standing the first step keeps its full length: with the feet side by side its swing
+    // foot travels one step length (half a stride, as a person's first step does) and eq. 3's
+    // symmetric heel strike puts the hip half a step ahead. It used to be a half step (the swing
+    // foot travelling a quarter stride): its heel-strike thigh angle (≈ 7° at 2 km/h) was less
+    // than the standing swing leg's own, so swing1 could not move the ankle forward (1 mm at
+    // 2 km/h), swing2 threw the foot 19 cm past its landing and swing3 pulled it back (swing
+    // ankle peak/mean speed 4.4–14.6), at 1 km/h the toe-clearance pitch sank the heel 1.5–3.2 mm
+    // into the ground, and the curve lift its clearance rounds needed (4.4 cm at 2 km/h) was
+    // carried into every later swing.
     if opts.stop && steps.len() > 1 {
         let f = steps.last_mut().into_iter().next();
         if let Some(f) = f {
