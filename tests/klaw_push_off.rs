@@ -33,7 +33,8 @@ fn approach(kmh: f64, h: f64) -> (f64, f64, usize) {
         if f < 2 || f + 3 >= m.len() {
             continue;
         }
-        let pelvis = |i: usize| 0.5 * (m.landmark(i, Landmark::LHip) + m.landmark(i, Landmark::RHip));
+        let pelvis =
+            |i: usize| 0.5 * (m.landmark(i, Landmark::LHip) + m.landmark(i, Landmark::RHip));
         let vy = (pelvis(f).y - pelvis(f - 1).y) * fps;
         let (hip, heel) = match e.side {
             Side::Left => (Landmark::LHip, Landmark::LHeel),
@@ -59,7 +60,7 @@ fn approach(kmh: f64, h: f64) -> (f64, f64, usize) {
 fn the_push_off_slows_the_hips_descent_into_heel_strike() {
     let cases = [(5.0, -0.40, 1.03), (7.0, -0.62, 1.63)];
     let measured: Vec<_> = cases.iter().map(|c| approach(c.0, 1.8)).collect();
-    for (&(kmh, vy_bound, close_bound), &(vy, closing, n)) in cases.iter().zip(&measured) {
+    for (&(kmh, _, _), &(vy, closing, n)) in cases.iter().zip(&measured) {
         println!("{kmh} km/h: pelvis vy before contact ≥ {vy:.3} m/s, hip approach to the heel ≤ {closing:.3} m/s over {n} contacts");
     }
     for (&(kmh, vy_bound, close_bound), &(vy, closing, n)) in cases.iter().zip(&measured) {
