@@ -509,25 +509,35 @@ pub fn generate_steps(
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
         let zf_w = side_z(swing_side, a);
-        // From standing, the second step's trailing leg (the first stance leg) stood flat or
-        // barely heeled off through the first step — the hip, starting at rest, never gets far
-        // enough ahead for the heel-off rule to roll it onto its toes — so it left the ground
-        // nearly flat with the knee almost straight, its shank vertical: swing1's slaved knee
-        // then lifted the ankle 12 cm almost straight up (2 km/h) and the knee switched to the
-        // ankle curve's other branch (7.5 cm in one frame). As at every other toe off, it now
-        // rolls onto its toes through the double support while the knee flexes to its toe-off
-        // value (the meta-off rule from the double support's start): the heel rises, the shank
-        // inclines, and the swing leaves as a steady one does (ankle peak/mean speed 4.3 → 2.3
-        // at 1 km/h). Not the first step's trailing leg: rolled from standing at 1 km/h, its short
-        // steep start put swing1's slaved knee on the curve's other branch at once (ratios
-        // 200–600).
-        if opt.start_from_rest && kk == 1 && trailing.period != FootPeriod::MetaOff {
+        // From standing, the first two trailing legs leave from their toes, as at every steady
+        // toe off: the meta-off rule from the start of the double support (the foot rolls onto
+        // its toes while the knee flexes to its toe-off value; the heel rises).
+        // The second step's trailing leg (the first stance leg) stood flat or barely heeled off
+        // through the first step — the hip, starting at rest, never gets far enough ahead for
+        // the heel-off rule to roll it — so it left the ground nearly flat with the knee almost
+        // straight and its shank vertical: swing1's slaved knee lifted the ankle 12 cm almost
+        // straight up (2 km/h) and then switched to the ankle curve's other branch (7.5 cm in one
+        // frame). The first step's trailing leg stands under the hip, where a flexed knee pitches
+        // the thigh forward: its knee flexes only as far as keeps the thigh at toe off behind
+        // `FIRST_TOE_OFF_THIGH` of its heel-strike angle (see there).
+        if opt.start_from_rest && kk < 2 && trailing.period != FootPeriod::MetaOff {
             let (hp, hz) = swing_hip3(0.0);
             let knee = trailing.pose_at(hp, hz - zf_w, trailing.rho).knee;
             trailing.period = FootPeriod::MetaOff;
             trailing.meta_start = Some((trailing_clock, knee));
             trailing.transitions[1].get_or_insert(trailing_clock);
             trailing.transitions[2] = Some(trailing_clock);
+            if kk == 0 {
+                let hips: Vec<(f64, [f64; 2], f64)> = (0..=n_v)
+                    .map(|i| {
+                        let t = t_ds * i as f64 / n_v as f64;
+                        let (hp, hz) = swing_hip3(t);
+                        (trailing_clock + t, hp, hz - zf_w)
+                    })
+                    .collect();
+                trailing.knee_toe_off =
+                    first_toe_off_knee(&trailing, &hips, knee, FIRST_TOE_OFF_THIGH * hs.theta3);
+            }
         }
         let mut trail_poses: Vec<(f64, LegPose, [f64; 2])> = Vec::with_capacity(n_v + 1);
         for i in 0..=n_v {
@@ -1160,6 +1170,58 @@ fn place_leg(
     let h = g.position(hip);
     let kn = g.position(Joint::leg(side)[1]);
     (h.x - kn.x).atan2(h.y - kn.y)
+}
+
+/// How far forward the first swing leg's thigh may be at toe off from standing, as a fraction of
+/// its heel-strike angle θ3 (eq. 3), so that swing1 still swings it forward to that angle.
+///
+/// The first trailing leg stands under the hip, so flexing its knee to the toe-off value (35°)
+/// pitches the thigh forward by about half of that — at 1–2 km/h beyond the heel-strike angle
+/// (≈ 10–15°) — and swing1, which brings the thigh to its heel-strike angle, then swung it back
+/// while the slaved knee dragged the ankle behind its start (at 1 km/h onto the curve's other
+/// branch: ratios 200–600). Measured (first swing's ankle peak/mean speed, 1.5/1.8/2.0 m): with
+/// 0.6 the knee flexes fully at 7 km/h, to 0.51–0.57 rad at 5 km/h and 0.41–0.46 at 3 km/h, and
+/// 5 / 7 km/h go from 3.2–3.8 / 2.5–2.9 (no roll) to 2.4–2.7 / 1.8–2.0, 1–3 km/h unchanged; at
+/// 1–2 km/h the bound leaves the knee no more flexion than the lowering hip gives it anyway, so
+/// that foot still leaves nearly flat (heel ≤ 7 mm up). 1.0 left 1 km/h's second swing at
+/// 5.4–6.4.
+pub const FIRST_TOE_OFF_THIGH: f64 = 0.6;
+
+/// The knee flexion the first trailing leg from standing flexes to through its double support
+/// (the meta-off rule, from `knee_now` at its start): the leg's own toe-off value, or less where
+/// that would leave the thigh at toe off further forward than `thigh_min` (θ3 < 0 forward). The
+/// thigh's angle at toe off is that of the sagittal hip–ankle chain after running the rule over
+/// `hips` (`(leg clock, hip, dz)`); it decreases as the knee flexes more (bisection, 20 halvings).
+fn first_toe_off_knee(
+    leg: &VirtualLeg,
+    hips: &[(f64, [f64; 2], f64)],
+    knee_now: f64,
+    thigh_min: f64,
+) -> f64 {
+    let thigh_for = |k: f64| {
+        let mut l = leg.clone();
+        l.knee_toe_off = k;
+        let mut last = None;
+        for &(t, hip, dz) in hips {
+            last = Some((l.advance(t, hip, dz).ankle, hip));
+        }
+        last.map_or(0.0, |(ankle, hip)| {
+            sagittal_angles(hip, ankle, leg.l3, leg.l4)[0]
+        })
+    };
+    let (mut lo, mut hi) = (knee_now.min(leg.knee_toe_off), leg.knee_toe_off);
+    if thigh_for(hi) >= thigh_min {
+        return hi;
+    }
+    for _ in 0..20 {
+        let mid = 0.5 * (lo + hi);
+        if thigh_for(mid) < thigh_min {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
 }
 
 /// The heel-rocker roll at which the straight leg `leg` reaches its ankle from the hip at `hip`
