@@ -385,8 +385,9 @@ fn swing_peak_over_mean(m: &Motion) -> Vec<f64> {
 /// hip is above the foot; see `FIRST_TOE_OFF_THIGH`), so swing1's slaved knee mostly lifts the
 /// ankle and swing2's knee extension carries most of the travel. The second swing (1.8 m:
 /// 1.6–2.9, was 1.6–7.5) meets it except at 2 km/h (2.9, as steady 2 km/h swings: 3.0; steady
-/// 1–2 km/h are 3–3.5, swing2's knee extension). The first two swings from standing are guarded
-/// at 1.25 × their measurement on klawfirst's branch (2026-11-27 02:25 UTC).
+/// 1–2 km/h are 3–3.5, swing2's knee extension). Asserted ≤ 2.5 from standing where met with a
+/// margin (second swing at 5 and 7 km/h, first at 7 km/h); the others are guarded at 1.25 × their
+/// measurement on klawfirst's branch (2026-11-27 02:25 UTC).
 #[test]
 fn swing_ankle_peak_speed_from_standing() {
     // Steady 5 and 7 km/h: the target.
@@ -416,11 +417,15 @@ fn swing_ankle_peak_speed_from_standing() {
         println!("from standing {v} km/h: {r:.2?}");
         assert!(r.len() >= 4, "{r:?}");
         for (k, measured) in [(0, first), (1, second)] {
-            if r[k] > 1.25 * measured {
-                failures.push(format!(
-                    "{v} km/h swing {k}: {:.2} > 1.25 × {measured}",
-                    r[k]
-                ));
+            // The target where it is met with a margin (the second swing at 5 and 7 km/h, the
+            // first at 7 km/h); elsewhere the guard.
+            let bound = if v >= 5.0 && (k == 1 || v >= 7.0) {
+                2.5
+            } else {
+                1.25 * measured
+            };
+            if r[k] > bound {
+                failures.push(format!("{v} km/h swing {k}: {:.2} > {bound}", r[k]));
             }
         }
     }
