@@ -2,9 +2,10 @@
 //!
 //! `checks::continuity` (k = 5: no frame-to-frame step of a landmark or joint larger than five
 //! times the median of its neighbours) is what the RUNNER meets. KLAW meets it at 1 km/h
-//! (1.5–2.0 m), 3 km/h (1.8, 2.0 m) and 4 km/h (1.8, 2.0 m, since the push-off,
+//! (1.5–2.0 m), 2 km/h (1.5 m, since the heel rocker's landing scan,
+//! `virtual_leg::ROCKER_SCAN`), 3 km/h (1.8, 2.0 m) and 4 km/h (1.8, 2.0 m, since the push-off,
 //! `stance::push_off_exponent`) — asserted as `passed` below — and not yet elsewhere
-//! (2026-11-27, klawpush: 2 km/h 6.3–6.8, 4–7 km/h 6.1–12.4, worst at heel strike, where KLAW's
+//! (2026-11-27, klawpush: 2 km/h 5.2–6.4, 4–7 km/h 6.1–12.4, worst at heel strike, where KLAW's
 //! hip closes on the landing heel at 0.98–1.54 m/s (5–7 km/h, 1.8 m), and at frame 0 of a steady
 //! walk, the same spike with no history). There the worst ratios measured on main are asserted with 25 %
 //! headroom (a **regression guard, not the target**) so that they cannot silently get
@@ -45,11 +46,12 @@ fn worst(sched: &[(f64, usize)], h: f64, rest_and_stop: bool) -> (f64, String) {
 
 /// Where KLAW meets k = 5 today (8 steps, steady start): the check itself must pass.
 #[test]
-fn continuity_is_met_at_1_3_and_4_kmh() {
+fn continuity_is_met_at_1_to_4_kmh() {
     let cases = [
         (1.0, 1.5),
         (1.0, 1.8),
         (1.0, 2.0),
+        (2.0, 1.5),
         (3.0, 1.8),
         (3.0, 2.0),
         (4.0, 1.8),
@@ -192,25 +194,25 @@ fn the_start_and_the_stop_do_not_regress() {
     // (km/h, height, from standing, measured worst ratio over the start, over the stop)
     #[rustfmt::skip]
     let cases: &[(f64, f64, bool, f64, f64)] = &[
-        (1.0, 1.5, false, 4.2, 2.9), // start 113 r_heel (5.6 at 12 l_knee, heel off, before the knee ease), stop 684 l_knee
+        (1.0, 1.5, false, 4.2, 2.6), // start 113 r_heel (5.6 at 12 l_knee, heel off, before the knee ease), stop 684 l_knee
         (1.0, 1.8, false, 4.2, 3.5), // start 111 r_knee, stop 751 l_knee
-        (1.0, 2.0, false, 4.2, 2.6), // start 117 r_knee (8.5 at 11 l_knee, heel off, before the knee ease), stop 793 l_knee
-        (2.0, 1.5, false, 6.3, 4.0), // start 80 r_knee, stop 482 l_heel
-        (2.0, 1.8, false, 5.0, 1.7), // start 79 l_elbow, stop 560 r_metatarsal
-        (2.0, 2.0, false, 5.3, 2.4), // start 92 r_heel, stop 557 l_heel
+        (1.0, 2.0, false, 4.2, 2.1), // start 117 r_knee (8.5 at 11 l_knee, heel off, before the knee ease), stop 793 l_knee
+        (2.0, 1.5, false, 4.6, 4.0), // start 80 r_knee, stop 482 l_heel; 6.3 before the rocker's landing scan
+        (2.0, 1.8, false, 5.0, 1.7), // start 79 l_elbow, stop 560 r_metatarsal; stop 2.12 at 580 l_elbow since the rocker's landing scan
+        (2.0, 2.0, false, 5.1, 2.4), // start 92 r_heel, stop 557 l_heel
         (3.0, 1.5, false, 4.9, 2.7), // start 0 l_ankle (5.0 before the push-off), stop 395 l_ankle
         (3.0, 1.8, false, 3.9, 2.9), // start 44 r_knee, stop 433 l_ankle
         (3.0, 2.0, false, 3.7, 2.3), // start 47 r_knee, stop 499 l_elbow
-        (5.0, 1.5, false, 12.1, 4.5), // start 0 l_ankle, stop 305 l_heel
+        (5.0, 1.5, false, 9.5, 4.4), // start 0 l_ankle, stop 305 l_heel; 12.1 before the rocker's landing scan
         (5.0, 1.8, false, 4.8, 4.9), // start 0 l_ankle (8.6 before the push-off), stop 334 l_heel
         (5.0, 2.0, false, 6.0, 4.9), // start 0 l_ankle (6.86 at 0 r_knee since the push-off: the trailing knee straightens to rest at the first heel strike), stop 352 l_heel
         (7.0, 1.5, false, 12.3, 3.5), // start 43 r_ankle, stop 258 l_ankle
         (7.0, 1.8, false, 9.7, 4.7), // start 0 l_ankle (16.1 before the push-off), stop 5.24 since the push-off, stop 282 l_heel
         (7.0, 2.0, false, 5.9, 2.3), // start 0 l_ankle (10.1 before the push-off), stop 2.41 since the push-off, stop 299 l_ankle
-        (1.0, 1.5, true, 5.6, 3.0), // start 113 r_heel, stop 684 l_knee
+        (1.0, 1.5, true, 5.6, 2.6), // start 113 r_heel, stop 684 l_knee
         (1.0, 1.8, true, 5.0, 3.4), // start 111 r_knee, stop 751 l_knee
-        (1.0, 2.0, true, 4.1, 2.7), // start 117 r_knee, stop 793 l_knee
-        (2.0, 1.5, true, 6.1, 4.1), // start 80 r_knee, stop 482 l_heel
+        (1.0, 2.0, true, 4.1, 2.1), // start 117 r_knee, stop 793 l_knee
+        (2.0, 1.5, true, 4.9, 4.1), // start 80 r_knee, stop 482 l_heel; 6.1 before the rocker's landing scan
         (2.0, 1.8, true, 4.1, 1.7), // start 176 l_knee, stop 560 r_metatarsal
         (2.0, 2.0, true, 4.4, 2.4), // start 185 l_heel (5.15 since the full first step), stop 557 l_heel
         (3.0, 1.5, true, 4.4, 2.7), // start 58 l_shoulder, stop 395 l_ankle
