@@ -330,3 +330,66 @@ fn slow_walk_knee_leaves_heel_strike_from_rest() {
 
 /// Worst knee ratio within ± 3 frames of a contact at 1 km/h, 1.5–2.0 m (3.84 at 1.5 m) × 1.25.
 const SLOW_KNEE_BOUND: f64 = 4.8;
+
+/// The stop's last half step (from the second-to-last heel strike, exclusive, to the last),
+/// steady start + stop, 6 steps, 1–3 km/h × 1.5/1.8/2.0 m: the swing that ends it used to race
+/// its slaved ankle down the ankle curve's far flank at the end of swing1 (2 km/h × 1.5 m: knee
+/// ratio 15.0, 1 km/h 5.8/6.3/6.4, 3 km/h 6.0/4.8/6.3), now with half the curve's lift
+/// (`generate::STOP_LIFT`, private). Bound: k = 5 where the measurement meets it, else 1.25 × the
+/// measurement (klawstop, 2026-11-27 03:10 UTC).
+#[test]
+fn the_stops_last_half_step_does_not_regress() {
+    // (km/h, height, measured worst ratio over the last half step)
+    #[rustfmt::skip]
+    let cases: &[(f64, f64, f64)] = &[
+        (1.0, 1.5, 4.49), // 575 l_elbow
+        (1.0, 1.8, 5.54), // 737 r_hand
+        (1.0, 2.0, 3.25), // 670 r_heel
+        (2.0, 1.5, 4.59), // 475 r_elbow (14.95 at 456 l_knee with the full lift)
+        (2.0, 1.8, 6.62), // 520 r_elbow (8.72 at 501 l_knee with the full lift)
+        (2.0, 2.0, 6.46), // 465 r_knee
+        (3.0, 1.5, 4.61), // 329 r_ankle (6.01 at 370 l_knee with the full lift)
+        (3.0, 1.8, 4.77), // 431 l_heel
+        (3.0, 2.0, 5.58), // 447 r_elbow (6.33 at 429 l_knee with the full lift)
+    ];
+    let mut failures = Vec::new();
+    for &(kmh, h, measured) in cases {
+        let opts = WalkOptions {
+            height_m: h,
+            stop: true,
+            ..Default::default()
+        };
+        let schedule = [ScheduleEntry {
+            params: WalkParams {
+                speed_m_per_s: Some(kmh / 3.6),
+                ..Default::default()
+            },
+            steps: 6,
+        }];
+        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let hs: Vec<f64> = m
+            .events
+            .iter()
+            .filter(|e| e.kind == EventKind::HeelStrike)
+            .map(|e| e.time_s * m.fps())
+            .collect();
+        let n = hs.len();
+        assert!(n >= 4, "{kmh} km/h {h} m: {n} heel strikes");
+        let region = hs[n - 3].ceil() as usize..hs[n - 2].ceil() as usize;
+        let r = continuity_over(&m, &ContinuityOptions::default(), region);
+        println!("{kmh} km/h {h} m, last half step: {r}");
+        assert!(r.examined > 100, "{} examined", r.examined);
+        let bound = if measured <= 5.0 {
+            5.0
+        } else {
+            1.25 * measured
+        };
+        if r.worst > bound {
+            failures.push(format!(
+                "{kmh} km/h {h} m, last half step: {:.2} > {bound:.2} (measured {measured})",
+                r.worst
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

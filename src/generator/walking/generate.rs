@@ -310,6 +310,21 @@ pub const MAX_CONTACT_ANKLE_RATE: f64 = 3.0;
 /// 7 km/h × 1.8 m stop's heel landing 4.7/5.5/5.8/7.0; 40 % was worse everywhere.
 const STOP_SWING1_DELAY: f64 = 0.05;
 
+/// Fraction of the ankle curve's lift (`ankle_lift_m`, §4.3's `a_max` over the curve's higher
+/// end) kept in the last step before a stop.
+///
+/// That half step's swing ankle leaves from a high heel (toe off, ≈ 15 cm at 2 km/h × 1.5 m) and
+/// ends swing1 lower (≈ 10 cm), so the full lift put the curve's far flank about along the
+/// circle the ankle can reach about the knee (slope ≈ −1 against the shank's −1.1 there): the
+/// slaved knee still swept the ankle 11 cm forward in two frames at 4.7 m/s just before t1
+/// (2 km/h × 1.5 m: knee ratio 15.0), which `STOP_SWING1_DELAY` alone did not remove. Half
+/// the lift flattens the flank; the swing1 clearance rounds still raise the curve wherever the
+/// toe needs it. Measured, not derived (worst ratio over that half step, steady start + stop,
+/// 1.5/1.8/2.0 m): full lift 1 km/h 5.8/6.3/6.4, 2 km/h 15.0/8.7/6.5, 3 km/h 6.0/4.8/6.3;
+/// half 4.5/5.5/3.3, 4.6/6.6/6.5, 4.6/4.8/5.6 (a quarter or none: the same within 0.05;
+/// 5–7 km/h unchanged).
+const STOP_LIFT: f64 = 0.5;
+
 /// Unrecorded steps simulated before a steady (not from rest) start.
 pub const PRE_ROLL: usize = 1;
 
@@ -635,7 +650,11 @@ pub fn generate_steps(
             theta3_hs: hs.theta3,
             theta5: [p0.theta5, a.ankle_mid_swing_deg.to_radians(), theta5_hs],
             theta6_toe_off: p0.toe_bend,
-            ankle_lift: a.ankle_lift_m,
+            ankle_lift: if to_rest {
+                STOP_LIFT * a.ankle_lift_m
+            } else {
+                a.ankle_lift_m
+            },
             tau: [
                 a.swing1_tau * (swing_times[1] - t0),
                 a.swing2_tau * (swing_times[2] - swing_times[1]),
