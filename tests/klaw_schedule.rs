@@ -544,3 +544,49 @@ fn the_second_swing_from_standing_leaves_from_its_toes() {
         );
     }
 }
+
+/// Standing, both feet flat on the floor: at the first frame of a walk from standing and at the
+/// last frame of its stop, heels and toes of both feet within 1 mm of the ground, 1–7 km/h ×
+/// 1.5/1.8/2.0 m (2 steps); and the first step leaves that pose without a jump (worst
+/// continuity ratio over its first 10 frames within k = 5).
+///
+/// The standing hip used to be a sagittal leg length l1 above the flat ankles, which in 3-D
+/// (hip half a pelvis width, ankle half a stride width from the midline: √(l1² + dz²)) put it
+/// ≈ 1 mm out of the leg's reach; the virtual leg's soft knee then rolled both feet onto their
+/// toes, heels 1–4 mm up at frame 0 (3 km/h: 1.5 m first stance heel 2.6 mm, 1.8 m 3.3 mm and
+/// the other 1.3 mm, 2.0 m 3.8 mm); now 0.0.
+#[test]
+fn heels_are_on_the_floor_while_standing() {
+    use gaitfit::generator::checks::{continuity_over, ContinuityOptions};
+    let mut failures = Vec::new();
+    for v in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0] {
+        for h in [1.5, 1.8, 2.0] {
+            let opts = WalkOptions {
+                height_m: h,
+                start_from_rest: true,
+                stop: true,
+                ..Default::default()
+            };
+            let (m, _) = generate_walk(&[kmh(v, 2)], &opts).unwrap();
+            for (what, f) in [("first", 0), ("last", m.len() - 1)] {
+                for lm in [
+                    Landmark::LHeel,
+                    Landmark::RHeel,
+                    Landmark::LToe,
+                    Landmark::RToe,
+                ] {
+                    let y = m.landmark(f, lm).y;
+                    if y.abs() > 1e-3 {
+                        failures.push(format!("{v} km/h {h} m, {what} frame: {lm:?} at {y:.4} m"));
+                    }
+                }
+            }
+            let start = continuity_over(&m, &ContinuityOptions::default(), 0..10);
+            println!("{v} km/h {h} m: first 10 frames {start}");
+            if !start.passed {
+                failures.push(format!("{v} km/h {h} m, first 10 frames: {start}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

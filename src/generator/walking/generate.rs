@@ -325,6 +325,10 @@ const STOP_SWING1_DELAY: f64 = 0.05;
 /// 5–7 km/h unchanged).
 const STOP_LIFT: f64 = 0.5;
 
+/// How much shorter than the soft knee's straight limit the standing legs are, m (floating-point
+/// margin, so that the standing feet are flat, not rolled by 1e-12).
+const STAND_MARGIN: f64 = 1e-4;
+
 /// Unrecorded steps simulated before a steady (not from rest) start.
 pub const PRE_ROLL: usize = 1;
 
@@ -375,8 +379,17 @@ pub fn generate_steps(
     } else {
         Side::Right
     };
+    // Standing (from rest): both feet flat under hips half a pelvis width apart, the feet a
+    // stride width apart. A sagittal leg of length l1 put the 3-D hip–ankle distance
+    // √(l1² + dz²) ≈ 1 mm beyond the leg's reach, and the virtual leg's soft knee (straight only
+    // up to l1 − 2·KNEE_SOFT) rolled both feet onto their toes: heels 1–3 mm up while standing.
+    // The standing hip is as high as the soft knee lets the flat feet stay down.
+    let dz_stand = half_width - 0.5 * a.stride_width_m;
+    let w_stand = ((body.l1 - 2.0 * KNEE_SOFT - STAND_MARGIN).powi(2) - dz_stand * dz_stand)
+        .max(0.0)
+        .sqrt();
     let mut stance_start = StanceStart {
-        q: [body.l1, 0.0, a.trunk_lean_deg.to_radians()],
+        q: [w_stand, 0.0, a.trunk_lean_deg.to_radians()],
         qd: [0.0; 3],
     };
     let mut from_rest = opt.start_from_rest;
