@@ -325,6 +325,20 @@ const STOP_SWING1_DELAY: f64 = 0.05;
 /// 5–7 km/h unchanged).
 const STOP_LIFT: f64 = 0.5;
 
+/// How much earlier (fraction of the swing) swing2 ends in the last step before a stop: its
+/// knee locks straight earlier and swing3 carries the straight leg to the heel strike.
+///
+/// With the default end (85 %) the half step's knee still extended at 10 rad/s into its lock
+/// one frame before it (2 km/h × 1.8 m: knee 0.075 → 0.102 → 0 rad/frame), jolting the thigh and,
+/// through the arm swing, the opposite shoulder and elbow (ratio 6.6). Measured, not derived
+/// (worst ratio over that half step, steady start + stop, 1.5/1.8/2.0 m, with `STOP_LIFT`):
+/// 85 % 1 km/h 4.5/5.5/3.3, 2 km/h 4.6/6.6/6.4, 3 km/h 4.6/4.8/5.6; 77 % 4.5/3.6/4.6,
+/// 4.3/4.5/5.0, 4.6/3.6/6.6 (3 km/h × 2.0 m worse, its knee at the lock); the closing after it
+/// 5 km/h 4.4/4.9/4.9 → 2.1/2.8/3.1 and 7 km/h × 1.8 m 5.2 → 4.5. 80 % left 7 km/h × 1.8 m's
+/// stop at 8.4, 78.5 % 1–3 km/h within 5.3 but 7 km/h × 1.5 m's half step 5.2 → 6.3; 75 % and
+/// 82 % were worse.
+const STOP_SWING2_ADVANCE: f64 = 0.08;
+
 /// How much shorter than the soft knee's straight limit the standing legs are, m (floating-point
 /// margin, so that the standing feet are flat, not rolled by 1e-12).
 const STAND_MARGIN: f64 = 1e-4;
@@ -651,7 +665,13 @@ pub fn generate_steps(
         } else {
             a.swing1_end
         };
-        let swing_times = [t0, t0 + swing1_end * tsw, t0 + a.swing2_end * tsw, t_step];
+        let swing2_end = if to_rest {
+            (a.swing2_end - STOP_SWING2_ADVANCE)
+                .max(swing1_end + 0.5 * (a.swing2_end - a.swing1_end))
+        } else {
+            a.swing2_end
+        };
+        let swing_times = [t0, t0 + swing1_end * tsw, t0 + swing2_end * tsw, t_step];
         let breakpoints = st_run.track.breakpoints();
         let hip_fn = &swing_hip;
         let sspec = SwingSpec {
