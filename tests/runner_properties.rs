@@ -675,8 +675,8 @@ fn start_and_stop_in_a_stand() {
 
 /// Refitted relations at the slow end (eq. 5's flights of 45 ms at 6 km/h): cases a random
 /// proptest seed found failing continuity at the last frame before the first heel strike
-/// (l_toe; 18 of 5151 cases of a 0.01 km/h × 0.01 m grid over 6–7 km/h × 1.5–2.0 m, all at
-/// 6.0–6.3 km/h, h ≥ 1.98 m; these two at 5.81 and 5.65). The landing knee alone was sped up
+/// (l_toe, or r_elbow in frame 47; 18 of 5151 cases of a 0.01 km/h × 0.01 m grid over
+/// 6–7 km/h × 1.5–2.0 m, all at 6.0–6.3 km/h, h ≥ 1.98 m; these two at 5.81 and 5.65). The landing knee alone was sped up
 /// to bring the heel down (`LANDING_SPEED`), flinging the foot forward into contact; the hip
 /// now shares it. And one a second seed found (6.41 km/h, 1.51 m: ratio 5.32 at frame 11,
 /// r_knee, the stance knee of the start switching into the toes-flat recovery; see
