@@ -9,12 +9,14 @@ use super::attributes::WalkAttributes;
 use super::body::Body;
 use super::collision::{self, SwingAtImpact};
 use super::dynamics::{HipMotion, StanceModel};
-use super::foot::FootShape;
+use super::foot::{smoothstep, FootShape};
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::stop::{Closing, StopStart};
 use super::swing::{SwingRun, SwingSpec, SwingStart};
-use super::virtual_leg::{smooth_roll, FootPeriod, LegPose, VirtualLeg, KNEE_SOFT};
+use super::virtual_leg::{
+    smooth_roll, FootPeriod, LegPose, VirtualLeg, KNEE_SOFT, TOE_OFF_KNEE_RATE,
+};
 use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
 use crate::generator::ik::leg_ik;
 use crate::generator::motion::{Motion, MotionMetadata};
@@ -228,6 +230,9 @@ impl Determinants {
 }
 
 struct StepData {
+    /// Whether the swing was braked (`SwingSpec::knee_brake`): only then is the drawn swing
+    /// ankle moved to the model's knee span (`swing_span_target`).
+    knee_brake: bool,
     side: Side,
     start: f64,
     loc: Locomotion,
@@ -437,7 +442,7 @@ pub fn generate_steps(
         trailing.period = FootPeriod::HeelOff;
     }
     let mut stance_guess = [0.0, 0.0];
-    let mut swing_guess = [0.0; 5];
+    let mut swing_guess = [0.0; 7];
     let mut recovery_by_leg = [0.0f64; 2];
     let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
         .chain(steps.iter().copied())
@@ -453,6 +458,18 @@ pub fn generate_steps(
     // The last pre-roll step's stance roll (its start, samples): the recorded walk's first
     // trailing leg is that leg, so its roll is smoothed across the two (see `smooth_rolls`).
     let mut pre_stance: Option<(f64, Vec<(f64, f64)>)> = None;
+    // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): the swings
+    // the start from standing and the stop were tuned on keep the paper's swing and toe off.
+    let knee_brake = |kk: usize| {
+        !((opt.start_from_rest && kk < FIRST_PAPER_SWINGS) || (opt.stop && kk + 2 >= all.len()))
+    };
+    let toe_off_rate = |kk: usize| {
+        if knee_brake(kk) {
+            TOE_OFF_KNEE_RATE
+        } else {
+            0.0
+        }
+    };
     for (kk, l) in all.iter().enumerate() {
         let recorded = kk >= pre;
         let k = kk.saturating_sub(pre);
@@ -547,6 +564,7 @@ pub fn generate_steps(
         let dt_v = 2e-3;
         let t_ds = times.double_support;
         trailing.toe_off_time = trailing_clock + t_ds;
+        trailing.toe_off_knee_rate = toe_off_rate(kk);
         trailing.min_knee_blend = MIN_KNEE_BLEND * t_ds;
         let mut trail_rho = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
@@ -613,6 +631,7 @@ pub fn generate_steps(
         let next_times = all
             .get(kk + 1)
             .map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
+        stance_leg.toe_off_knee_rate = toe_off_rate(kk + 1);
         stance_leg.toe_off_time = t_step
             + next_times
                 .map(|t| t.double_support)
@@ -674,6 +693,15 @@ pub fn generate_steps(
         let swing_times = [t0, t0 + swing1_end * tsw, t0 + swing2_end * tsw, t_step];
         let breakpoints = st_run.track.breakpoints();
         let hip_fn = &swing_hip;
+        let theta3_rate_hs = neutral_landing_rate(
+            &body,
+            &model,
+            &st_run.end,
+            [ax, body.l9],
+            swing_hip(t_step),
+            hs.theta3,
+            [ax + l.step_length_m, body.l9],
+        );
         let sspec = SwingSpec {
             model: swing_model,
             foot,
@@ -697,6 +725,11 @@ pub fn generate_steps(
             clearance: a.toe_clearance_m,
             theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
             max_step: a.max_step_s,
+            // The first two swings from standing keep the paper's swing2 (klawfirst's start).
+            // The first swing from standing and the last two before a stop keep the paper's
+            // swing2 and swing3 (see `SwingSpec::knee_brake`).
+            knee_brake: knee_brake(kk),
+            theta3_rate_hs,
         };
         // The swing2 recovery's actuator is carried over from the same leg's last swing: fast
         // walks alternate between legs (period-two pattern of the recovery).
@@ -768,6 +801,7 @@ pub fn generate_steps(
                 stance: st_run,
                 swing: sw,
                 swing_foot: sspec.swing_foot(),
+                knee_brake: sspec.knee_brake,
                 swing_times,
                 stance_rho,
                 stance_leg: stance_leg.clone(),
@@ -964,10 +998,11 @@ fn assemble(
     let frames = (total * opt.fps).floor() as usize + 1;
     motion.reserve(frames);
     let swing_model = super::dynamics::SwingModel::new(body);
+    let mut arms = ArmLag::new(opt.fps);
     for i in 0..frames {
         let t = (i as f64 / opt.fps).min(total);
         if let Some(c) = closing.filter(|c| t > c.start) {
-            let (pose, contact) = closing_pose(skeleton, foot, c, t, a);
+            let (pose, contact) = closing_pose(skeleton, foot, c, t, a, &mut arms);
             motion.push_frame(pose, contact);
             continue;
         }
@@ -1019,15 +1054,21 @@ fn assemble(
             let (_, an) = swing_model.knee_ankle(&sq);
             let ankle = [hip[0] + an[0], hip[1] + an[1]];
             let (pitch, th6) = d.swing_foot.pose(tau, ankle, sq[0] + sq[1]);
+            let [_, t1, t2, _] = d.swing_times;
+            let target = swing_span_target(
+                skeleton,
+                &pose,
+                swing,
+                [ankle[0], ankle[1], side_z(swing, a)],
+                an[0].hypot(an[1]),
+                if d.knee_brake {
+                    smoothstep((tau - t1) / (t2 - t1))
+                } else {
+                    0.0
+                },
+            );
             (
-                place_leg(
-                    skeleton,
-                    &mut pose,
-                    swing,
-                    [ankle[0], ankle[1], side_z(swing, a)],
-                    pitch,
-                    th6,
-                ),
+                place_leg(skeleton, &mut pose, swing, target, pitch, th6),
                 false,
             )
         };
@@ -1046,7 +1087,12 @@ fn assemble(
             Joint::Head,
             DQuat::from_rotation_y(yaw * (1.0 - a.spine_compensation)),
         );
-        swing_arms(&mut pose, a, [(stance, swing_thigh), (swing, stance_thigh)]);
+        swing_arms(
+            &mut pose,
+            a,
+            &mut arms,
+            [(stance, swing_thigh), (swing, stance_thigh)],
+        );
         let mut contact = [false; 2];
         contact[match stance {
             Side::Left => 0,
@@ -1140,8 +1186,10 @@ fn closing_pose(
     c: &Closing,
     t: f64,
     a: &WalkAttributes,
+    arms: &mut ArmLag,
 ) -> (crate::generator::skeleton::Pose, [bool; 2]) {
     let f = c.frame(t - c.start, foot);
+    arms.settle = smoothstep(((t - c.start) / c.duration).clamp(0.0, 1.0));
     let mut pose = skeleton.rest_pose();
     pose.root = DVec3::new(f.hip[0], f.hip[1], f.lateral);
     let (w, tr) = (c.stance, c.stance.opposite());
@@ -1162,7 +1210,7 @@ fn closing_pose(
     pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_z(-f.lean));
     pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, 0.0));
     pose.set_world_rotation(Joint::Head, DQuat::IDENTITY);
-    swing_arms(&mut pose, a, [(w, trail_thigh), (tr, stance_thigh)]);
+    swing_arms(&mut pose, a, arms, [(w, trail_thigh), (tr, stance_thigh)]);
     let mut contact = [true; 2];
     contact[match tr {
         Side::Left => 0,
@@ -1178,15 +1226,61 @@ fn closing_pose(
 fn swing_arms(
     pose: &mut crate::generator::skeleton::Pose,
     a: &WalkAttributes,
+    arms: &mut ArmLag,
     sides: [(Side, f64); 2],
 ) {
     let arm_gain = a.arm_swing_deg / 25.0;
-    for (side, opposite_thigh) in sides {
+    for (side, thigh) in sides {
+        let opposite_thigh = arms.follow(side, thigh);
         let [_, shoulder, elbow, _] = Joint::arm(side);
         let flex = -arm_gain * opposite_thigh;
         pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
         let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
         pose.set_euler(elbow, Euler::sagittal(elbow_flex));
+    }
+}
+
+/// Time constant of the arms' lag behind the opposite thigh, s ([`ArmLag`]).
+const ARM_LAG: f64 = 0.03;
+
+/// The arms follow the opposite thigh through a first-order lag of [`ARM_LAG`] (the arm is a
+/// pendulum driven at the shoulder, not welded to the thigh). Why: the thigh's rate changes
+/// within a frame or two at heel strike (the swing thigh lands retracting at the
+/// collision-neutral rate, the new stance thigh leaves at another), and a one-to-one copy put
+/// that kink into the shoulder (4 km/h, 1.8/2.0 m: r_shoulder 6.1/6.4 × its neighbours' step
+/// on the last frame before heel strike). The lag keeps the arm's rate continuous (C¹ angle)
+/// and delays it by ≈ 30 ms, under a tenth of a step. In the stop's closing the lag fades out
+/// (smoothstep over the closing), so the arms come to rest exactly when the legs do.
+struct ArmLag {
+    /// Filter weight per frame, 1 − exp(−Δt/τ).
+    alpha: f64,
+    /// How far the lag has faded out, 0 (full lag) to 1 (the arm copies the thigh).
+    settle: f64,
+    /// The lagged thigh angle per arm (left, right), rad; `None` before the first frame.
+    state: [Option<f64>; 2],
+}
+
+impl ArmLag {
+    fn new(fps: f64) -> Self {
+        Self {
+            alpha: 1.0 - (-1.0 / (fps * ARM_LAG)).exp(),
+            settle: 0.0,
+            state: [None; 2],
+        }
+    }
+
+    /// Advances `side`'s arm by one frame towards the opposite thigh angle `thigh`.
+    fn follow(&mut self, side: Side, thigh: f64) -> f64 {
+        let slot = &mut self.state[match side {
+            Side::Left => 0,
+            Side::Right => 1,
+        }];
+        let y = match *slot {
+            Some(y) => y + (self.alpha + (1.0 - self.alpha) * self.settle) * (thigh - y),
+            None => thigh,
+        };
+        *slot = Some(y);
+        y
     }
 }
 
@@ -1205,6 +1299,80 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
 
 /// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
 /// Returns the sagittal thigh angle (positive: knee behind the hip).
+/// Swings from standing that keep the paper's swing and toe off (the start's first two swings,
+/// klawfirst's; see `SwingSpec::knee_brake`).
+const FIRST_PAPER_SWINGS: usize = 3;
+
+/// The swing thigh's rate θ̇3 at heel strike for which the collision
+/// ([`collision::heel_strike`]) leaves the stance hip's forward velocity unchanged, rad/s: the
+/// new stance's generalized momenta are linear in θ̇3 (the swing leg's angular momentum about
+/// the new pivot), so two evaluations give it exactly. `old` is the stance state at heel strike,
+/// `hip` the swing hip's motion then, `theta3` the heel-strike thigh angle (eq. 3).
+fn neutral_landing_rate(
+    body: &Body,
+    model: &StanceModel,
+    old: &[f64; 6],
+    old_ankle: [f64; 2],
+    hip: HipMotion,
+    theta3: f64,
+    new_ankle: [f64; 2],
+) -> f64 {
+    let [w, t1, _, wd, t1d, _] = *old;
+    let before = wd * t1.sin() + w * t1d * t1.cos();
+    let jump = |rate: f64| {
+        let s = collision::heel_strike(
+            body,
+            model,
+            old,
+            old_ankle,
+            &SwingAtImpact {
+                hip: hip.pos,
+                hip_vel: hip.vel,
+                theta3: [theta3, rate],
+            },
+            new_ankle,
+        );
+        let (q, qd) = (s.q, s.qd);
+        qd[0] * q[1].sin() + q[0] * qd[1] * q[1].cos() - before
+    };
+    let (j0, j1) = (jump(0.0), jump(1.0));
+    if (j1 - j0).abs() > 1e-12 {
+        -j0 / (j1 - j0)
+    } else {
+        0.0
+    }
+}
+
+/// The drawn swing ankle's target: the sagittal model's ankle, moved along the line from the
+/// skeleton's hip joint by the fraction `w` of the way to the model's hip–ankle span `span`.
+///
+/// Why: the swing model is sagittal, but the drawn hip joint sits ≈ 4 cm beside the foot's line,
+/// so the 3-D hip–ankle distance is ≈ dz²/2d ≈ 1 mm longer than the model's and the drawn knee
+/// is ≈ 5° straighter. Near the end of swing2, where the model's knee comes to rest straight
+/// ([`SwingSpec`]'s knee brake), the drawn knee would hit straight (the ankle out of reach) some
+/// 20 ms early and stop there in one frame, snapping the thigh (and the arms, which follow the
+/// thigh). With `w` = 1 the drawn knee has the model's angle exactly; `w` ramps in over swing2
+/// (so the toe-off ankle, drawn where the stance foot left it, does not jump), and the ankle
+/// moves by that millimetre gradually. At heel strike the straight leg is drawn along the line
+/// to its out-of-reach ankle as before.
+fn swing_span_target(
+    skeleton: &Skeleton,
+    pose: &crate::generator::skeleton::Pose,
+    side: Side,
+    ankle: [f64; 3],
+    span: f64,
+    w: f64,
+) -> [f64; 3] {
+    let h = skeleton.forward(pose).position(Joint::leg(side)[0]);
+    let v = DVec3::new(ankle[0], ankle[1], ankle[2]) - h;
+    let len = v.length();
+    if w <= 0.0 || len <= 1e-9 {
+        return ankle;
+    }
+    let p = h + v * (1.0 - w + w * span / len);
+    [p.x, p.y, p.z]
+}
+
 fn place_leg(
     skeleton: &Skeleton,
     pose: &mut crate::generator::skeleton::Pose,

@@ -6,9 +6,12 @@
 //!   angle is set, at every evaluation, so that the ankle lies on the 4th-order polynomial `P`
 //!   through the five conditions of §4.3;
 //! - *swing2* (t1 → t2): hip held by a spring–damper about the heel-strike angle, knee torque
-//!   `F_θ4 = B·e^{−(t−t1)/τ}`, `B` found so that the knee is straight (`θ4 = 0`) exactly at t2;
+//!   `F_θ4 = B·e^{−(t−t1)/τ}`, `B` found so that the knee is straight (`θ4 = 0`) exactly at t2 —
+//!   here plus a terminal knee brake `E·uⁿ` (with a hip-extension share, the hamstrings), `B`
+//!   and `E` found together so that the knee is also at rest at t2 ([`KNEE_BRAKE_POWER`]: the
+//!   paper's knee slams into the lock at 5–7 rad/s);
 //!   if a foot point comes closer to the ground than the toe clearance, a position actuator
-//!   (a temporary forward shift of the hip's set point, `pa3·sin(π·τ)`) is increased step by step
+//!   (a temporary forward shift of the hip's set point, `pa3·sin(π·τ)`, here over the first [`RECOVERY_END`] of swing2) is increased step by step
 //!   and swing2 repeated — the ground-stubbing recovery;
 //! - *swing3* (t2 → heel strike): the knee is locked straight (the locking impulse conserves the
 //!   thigh's generalized momentum), hip torque `F_θ3 = C·e^{−(t−t2)/τ}`, `C` found so that
@@ -21,7 +24,7 @@ use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
 use super::foot::{smoothstep, FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
-use super::shooting::solve_1d;
+use super::shooting::{solve_1d, solve_2d, Solved};
 use super::track::{Node, Track};
 use std::f64::consts::FRAC_PI_2;
 
@@ -56,6 +59,28 @@ pub struct SwingSpec<'a> {
     pub theta5_max: f64,
     /// Largest integration step, s.
     pub max_step: f64,
+    /// Whether swing2 ends with the knee brought to rest ([`KNEE_BRAKE_POWER`], the recovery's
+    /// shift over [`RECOVERY_END`]) and swing3 lands the thigh at
+    /// [`SwingSpec::theta3_rate_hs`]; otherwise the paper's swing2 and swing3 (one torque each,
+    /// the knee locks at whatever rate it reaches).
+    ///
+    /// `generate` keeps the paper's swing for the first swing from standing and the last two
+    /// swings before a stop: the start's first half step and the kinematic stop were tuned on
+    /// it (braked there, the first swing's landing knee at 5 km/h went from ratio 11.4 to 23,
+    /// and the stop's landing knee at 1 km/h × 1.5 m from 3.0 to 4.8).
+    pub knee_brake: bool,
+    /// Thigh rate θ̇3 at heel strike, rad/s, which swing3 meets (with a second torque, a ramp
+    /// `D·(t − t2)/(t_swing − t2)`) when `knee_brake` is set: `generate` passes the rate for
+    /// which the heel-strike collision leaves the hip's forward velocity unchanged.
+    ///
+    /// Why: swing3's single exponential torque landed whatever rate it reached. With the
+    /// paper's lock that was a 1.8–2.4 rad/s retraction; with the braked knee the thigh arrives
+    /// at t2 near its heel-strike angle and at rest, and the free rate came out between −0.6
+    /// (still flexing, at 5–7 km/h: the collision then threw the hip forward by 0.12 m/s, and
+    /// the trailing knee and ankle spiked at heel strike) and +0.6 rad/s. The collision's
+    /// momentum balance is linear in θ̇3, so the rate that keeps the hip's forward velocity
+    /// continuous is known before the swing is simulated.
+    pub theta3_rate_hs: f64,
 }
 
 /// The kinematic swing foot (§4.3): the ankle angle θ5 and the toe bend θ6 are interpolated
@@ -248,9 +273,11 @@ pub struct SwingRun {
     pub track: Track<2>,
     /// Shooting iterations of swing1, swing2 (all recovery rounds), swing3.
     pub iterations: [usize; 3],
-    /// Torque parameters `A`, `B`, `C` found, the swing1 recovery's lift of the ankle curve (m)
-    /// and the swing2 recovery's position actuator (rad); the next step starts from them.
-    pub params: [f64; 5],
+    /// Torque parameters `A`, `B`, `C` found, the swing1 recovery's lift of the ankle curve (m),
+    /// the swing2 recovery's position actuator (rad), the swing2 knee brake `E` (see
+    /// [`KNEE_BRAKE_POWER`]) and swing3's ramp `D` (see [`SwingSpec::theta3_rate_hs`]); the
+    /// next step starts from them.
+    pub params: [f64; 7],
     /// Final position actuator of the stubbing recovery, rad (0 if not needed).
     pub recovery: f64,
     /// Recovery rounds used.
@@ -272,6 +299,44 @@ const RECOVERY_STEP: f64 = 0.02;
 /// spring lifts the foot only ≈ 1 mm per increment in fast walks of short bodies (7 km/h at
 /// 1.5 m needs ≈ 25); 20 left the heel up to 4 mm in the ground there.
 const RECOVERY_MAX: usize = 40;
+
+/// Power `n` of the swing2 knee brake's shape `E·uⁿ` (`u` the fraction of swing2): the brake
+/// acts in terminal swing, where the hamstrings decelerate a human knee's extension.
+///
+/// Why a brake at all: with the paper's single exponential knee torque the knee slammed into
+/// the swing3 lock at 5–7 rad/s (measured at every speed; 7.0 rad/s at 3 km/h × 1.8 m once the
+/// toe off is brisk, [`super::virtual_leg::TOE_OFF_KNEE_RATE`]) and the lock's inelastic impulse
+/// (θ̇3⁺ = θ̇3 + (M01/M00)·θ̇4) kicked the thigh by ≈ 2.5 rad/s in one instant; the arms, which
+/// follow the thigh, showed it as elbow/shoulder spikes (continuity ratios 6.3–6.5 at 3 km/h).
+/// With the brake, swing2 solves for two torque magnitudes (`B`, `E`) so that the knee is
+/// straight *and at rest* at t2: the lock conserves everything and the knee decelerates into
+/// extension, as a human knee does before heel strike. 6: measured against 2, 4 and 8 (8 steps,
+/// 1–4 km/h × 1.5/1.8/2.0 m and the default-event double support): the broader shapes brake
+/// while the foot is still low and need a larger stubbing recovery.
+pub const KNEE_BRAKE_POWER: i32 = 6;
+
+/// Ratio of the knee brake's hip-extension torque to its knee-flexion torque (the hamstrings'
+/// moment arms, ≈ 6–7 cm at the hip and 3–4 cm at the knee).
+///
+/// Why: the knee torque is internal to the leg, so a brake on the knee alone hands the knee's
+/// momentum to the thigh just like the lock did (the thigh then swung forward at 1.5–1.8 rad/s
+/// at t2 and swing3 had to pull it back, heel-strike thigh rates 3–4 rad/s); a biarticular
+/// brake takes it out at the hip as well. Measured: 1 left the thigh swinging forward at
+/// 0.4–1.1 rad/s at t2, 2 leaves it within ±0.6 rad/s of rest, 3 over-retracted (default-event
+/// heel strikes 25–30 ms late at every speed).
+pub const KNEE_BRAKE_HIP_RATIO: f64 = 2.0;
+
+/// Fraction of swing2 over which the ground-stubbing recovery's set-point shift
+/// `pa·sin(π·u/RECOVERY_END)` acts (the paper's shape spans all of swing2).
+///
+/// Why: the hip spring–damper lags its set point, so a shift that returned to the heel-strike
+/// angle only at t2 left the thigh 0.05–0.09 rad ahead of it in slow walks (1.5–3 km/h, which
+/// need the recovery); swing3 then pulled the thigh back and the heel, having swung past its
+/// landing spot, came back 3–17 cm at up to 4.5 m/s over the ground before contact (gaitfit's
+/// foot-speed events saw the heel strike 30–60 ms early). Ending the shift at 85 % of swing2
+/// gives the thigh the rest of swing2 to settle (measured: 0.8 over-corrected at 3 km/h × 2.0 m,
+/// 0.9 left 1.5 km/h × 1.6 m's double support 42 ms long).
+pub const RECOVERY_END: f64 = 0.85;
 
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
@@ -513,7 +578,7 @@ impl SwingSpec<'_> {
     fn swing2(
         &self,
         y0: [f64; 4],
-        b: f64,
+        be: [f64; 2],
         pa: f64,
         h: f64,
         rec: Option<&mut Track<2>>,
@@ -522,11 +587,15 @@ impl SwingSpec<'_> {
         let [k3, c3] = self.hip_spring;
         let tau = self.tau[1];
         let th3_hs = self.theta3_hs;
+        let end = if self.knee_brake { RECOVERY_END } else { 1.0 };
         let f = |t: f64, y: &[f64; 4]| {
             let hip = (self.hip)(t);
-            let set = th3_hs - pa * (std::f64::consts::PI * (t - t1) / (t2 - t1)).sin();
-            let f3 = -k3 * (y[0] - set) - c3 * y[2];
-            let f4 = b * (-(t - t1) / tau).exp();
+            let u = (t - t1) / (t2 - t1);
+            let set = th3_hs - pa * (std::f64::consts::PI * (u / end).min(1.0)).sin();
+            // The knee brake (hamstrings): flexes the knee and extends the hip.
+            let brake = be[1] * u.powi(KNEE_BRAKE_POWER);
+            let f3 = -k3 * (y[0] - set) - c3 * y[2] + KNEE_BRAKE_HIP_RATIO * brake;
+            let f4 = be[0] * (-(t - t1) / tau).exp() + brake;
             let acc = self
                 .model
                 .accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, f4], &hip.acc, false);
@@ -564,12 +633,12 @@ impl SwingSpec<'_> {
         (y, lowest)
     }
 
-    fn swing3(&self, y0: [f64; 2], c: f64, h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
+    fn swing3(&self, y0: [f64; 2], cd: [f64; 2], h: f64, rec: Option<&mut Track<2>>) -> [f64; 2] {
         let [_, _, t2, t3] = self.times;
         let tau = self.tau[2];
         let f = |t: f64, y: &[f64; 2]| {
             let hip = (self.hip)(t);
-            let ft = c * (-(t - t2) / tau).exp();
+            let ft = cd[0] * (-(t - t2) / tau).exp() + cd[1] * (t - t2) / (t3 - t2);
             let acc = self
                 .model
                 .accel(&[y[0], 0.0], &[y[1], 0.0], &[ft, 0.0], &hip.acc, true);
@@ -609,7 +678,7 @@ impl SwingSpec<'_> {
     pub fn solve(
         &self,
         start: &SwingStart,
-        guess: [f64; 5],
+        guess: [f64; 7],
         speed: f64,
     ) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
@@ -683,24 +752,45 @@ impl SwingSpec<'_> {
         let k_prev = (guess[4].max(0.0) / RECOVERY_STEP).round() as usize;
         let mut k = k_prev.saturating_sub(1).min(RECOVERY_MAX);
         let mut it2 = 0;
-        let mut b_guess = guess[1];
+        let mut b_guess = [guess[1], guess[5]];
         // Largest failing k and its clearance; least clear k and its solve.
         let mut fail_hi: Option<(usize, f64)> = None;
         let mut clear_lo = None;
         let mut best_fail = None;
         let (s2, lowest, rounds) = loop {
             let pa = k as f64 * RECOVERY_STEP;
-            let s2 = solve_1d(
-                |b| self.swing2(y2_0, b, pa, h, None).0[1],
-                b_guess,
-                0.2 * scale,
-                TOL,
-                60,
-            )
-            .map_err(|e| format!("swing2: {e}"))?;
+            // θ4(t2) = 0 and θ̇4(t2) = 0 (the rate scaled by swing2's duration, so both
+            // residuals are angles): the knee comes to rest straight where it locks.
+            let s2 = if !self.knee_brake {
+                let s = solve_1d(
+                    |b| self.swing2(y2_0, [b, 0.0], pa, h, None).0[1],
+                    b_guess[0],
+                    0.2 * scale,
+                    TOL,
+                    60,
+                )
+                .map_err(|e| format!("swing2: {e}"))?;
+                Solved {
+                    x: [s.x[0], 0.0],
+                    residual: [s.residual[0], 0.0],
+                    iterations: s.iterations,
+                }
+            } else {
+                solve_2d(
+                    |be| {
+                        let y = self.swing2(y2_0, be, pa, h, None).0;
+                        [y[1], y[3] * (t2 - t1)]
+                    },
+                    b_guess,
+                    [0.01 * scale, 0.01 * scale],
+                    [TOL, TOL],
+                    80,
+                )
+                .map_err(|e| format!("swing2: {e}"))?
+            };
             it2 += s2.iterations;
-            let (_, lowest) = self.swing2(y2_0, s2.x[0], pa, h, None);
-            b_guess = s2.x[0];
+            let (_, lowest) = self.swing2(y2_0, s2.x, pa, h, None);
+            b_guess = s2.x;
             if lowest >= self.clearance {
                 clear_lo = Some((s2, lowest, k));
                 let below_fails = fail_hi.is_some_and(|(kf, _)| kf + 1 == k);
@@ -744,22 +834,47 @@ impl SwingSpec<'_> {
         };
         let pa = rounds as f64 * RECOVERY_STEP;
         let before = track.nodes.len();
-        let (y2, _) = self.swing2(y2_0, s2.x[0], pa, h, Some(&mut track));
+        let (y2, _) = self.swing2(y2_0, s2.x, pa, h, Some(&mut track));
         let _ = before;
         // Knee lock at t2: the knee's impulse leaves the thigh's generalized momentum unchanged.
         let m = self.model.mass_matrix(&[y2[0], y2[1]]);
         let th3d =
             (m[0][0] * y2[2] + m[0][1] * y2[3]) / self.model.mass_matrix(&[y2[0], 0.0])[0][0];
         let y3_0 = [y2[0], th3d];
-        let s3 = solve_1d(
-            |c| self.swing3(y3_0, c, h, None)[0] - self.theta3_hs,
-            guess[2],
-            0.2 * scale,
-            TOL,
-            60,
-        )
-        .map_err(|e| format!("swing3: {e}"))?;
-        let y3 = self.swing3(y3_0, s3.x[0], h, Some(&mut track));
+        // swing3: `C` so that the thigh reaches its heel-strike angle at t_swing; with the knee
+        // brake also a ramp `D` so that it lands at `theta3_rate_hs` (see that field).
+        let t3 = self.times[3];
+        let s3 = if self.knee_brake {
+            solve_2d(
+                |cd| {
+                    let y = self.swing3(y3_0, cd, h, None);
+                    [
+                        y[0] - self.theta3_hs,
+                        (y[1] - self.theta3_rate_hs) * (t3 - t2),
+                    ]
+                },
+                [guess[2], guess[6]],
+                [0.01 * scale, 0.01 * scale],
+                [TOL, TOL],
+                80,
+            )
+            .map_err(|e| format!("swing3: {e}"))?
+        } else {
+            let s = solve_1d(
+                |c| self.swing3(y3_0, [c, 0.0], h, None)[0] - self.theta3_hs,
+                guess[2],
+                0.2 * scale,
+                TOL,
+                60,
+            )
+            .map_err(|e| format!("swing3: {e}"))?;
+            Solved {
+                x: [s.x[0], 0.0],
+                residual: [s.residual[0], 0.0],
+                iterations: s.iterations,
+            }
+        };
+        let y3 = self.swing3(y3_0, s3.x, h, Some(&mut track));
         // Clearance over the swing from 30 % of swing1 on (the toe is leaving before that).
         let t_check = t0 + 0.3 * (t1 - t0);
         let min_clearance = track
@@ -771,7 +886,7 @@ impl SwingSpec<'_> {
         let _ = lowest;
         Ok(SwingRun {
             iterations: [it1, it2, s3.iterations],
-            params: [a1, s2.x[0], s3.x[0], extra, pa],
+            params: [a1, s2.x[0], s3.x[0], extra, pa, s2.x[1], s3.x[1]],
             recovery: pa,
             recovery_rounds: rounds + lift_rounds,
             min_clearance,
