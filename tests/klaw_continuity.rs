@@ -14,6 +14,7 @@
 //! Tighten the bounds when a fix lands; move a walk to the `passed` list when it meets k = 5.
 use gaitfit::events::EventKind;
 use gaitfit::generator::checks::{continuity, continuity_over, ContinuityOptions};
+use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::Joint;
 use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
 
@@ -114,7 +115,7 @@ const BOUND_7KMH: f64 = 13.2; // measured 10.57 (frame 283, l_ankle, heel strike
 const BOUND_SCHEDULE: f64 = 7.2; // measured 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
 
 /// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
-fn joint_steps(m: &gaitfit::generator::motion::Motion, joint: Joint) -> Vec<f64> {
+fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
     let ji = joint.index();
     m.poses()
         .windows(2)
@@ -165,6 +166,32 @@ fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
 /// Worst ankle ratio within ± 3 frames of a heel strike, measured (klawhs) × 1.25.
 const HS_ANKLE_5KMH: f64 = 1.25 * 6.06; // 8.1 before the push-off
 const HS_ANKLE_7KMH: f64 = 1.25 * 10.57; // 13.9 before the push-off
+
+/// A walk of 6 steps at `kmh` and height `h` that ends in a stop (from standing if `rest`), and
+/// its heel strikes as fractional frame numbers.
+fn six_steps_to_a_stop(kmh: f64, h: f64, rest: bool) -> (Motion, Vec<f64>) {
+    let opts = WalkOptions {
+        height_m: h,
+        start_from_rest: rest,
+        stop: true,
+        ..Default::default()
+    };
+    let schedule = [ScheduleEntry {
+        params: WalkParams {
+            speed_m_per_s: Some(kmh / 3.6),
+            ..Default::default()
+        },
+        steps: 6,
+    }];
+    let (m, _) = generate_walk(&schedule, &opts).unwrap();
+    let hs = m
+        .events
+        .iter()
+        .filter(|e| e.kind == EventKind::HeelStrike)
+        .map(|e| e.time_s * m.fps())
+        .collect();
+    (m, hs)
+}
 
 /// The start and the stop, region by region (`checks::continuity_over`: the same ratios, local
 /// medians over the whole motion, reported only for the steps that begin in the region), for
@@ -230,26 +257,7 @@ fn the_start_and_the_stop_do_not_regress() {
     ];
     let mut failures = Vec::new();
     for &(kmh, h, rest, start_ratio, stop_ratio) in cases {
-        let opts = WalkOptions {
-            height_m: h,
-            start_from_rest: rest,
-            stop: true,
-            ..Default::default()
-        };
-        let schedule = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps: 6,
-        }];
-        let (m, _) = generate_walk(&schedule, &opts).unwrap();
-        let hs: Vec<f64> = m
-            .events
-            .iter()
-            .filter(|e| e.kind == EventKind::HeelStrike)
-            .map(|e| e.time_s * m.fps())
-            .collect();
+        let (m, hs) = six_steps_to_a_stop(kmh, h, rest);
         assert!(hs.len() >= 4, "{kmh} km/h {h} m: {} heel strikes", hs.len());
         let o = ContinuityOptions::default();
         let start = continuity_over(&m, &o, 0..hs[1].ceil() as usize);
@@ -270,7 +278,7 @@ fn the_start_and_the_stop_do_not_regress() {
 
 /// Heel strikes with 4 frames of swing before and 4 of stance after (so not the walk's first
 /// frame): the first frame at or after each contact, and its side.
-fn contact_frames(m: &gaitfit::generator::motion::Motion) -> Vec<(usize, gaitfit::events::Side)> {
+fn contact_frames(m: &Motion) -> Vec<(usize, gaitfit::events::Side)> {
     let fps = m.fps();
     m.events
         .iter()
@@ -282,10 +290,7 @@ fn contact_frames(m: &gaitfit::generator::motion::Motion) -> Vec<(usize, gaitfit
 
 /// Worst continuity ratio of `joint_of(side)` within ± 3 frames of the walk's heel strikes
 /// ([`contact_frames`]), and the number of contacts examined.
-fn contact_ratio(
-    m: &gaitfit::generator::motion::Motion,
-    joint_of: impl Fn(gaitfit::events::Side) -> Joint,
-) -> (f64, usize) {
+fn contact_ratio(m: &Motion, joint_of: impl Fn(gaitfit::events::Side) -> Joint) -> (f64, usize) {
     let mut worst: f64 = 0.0;
     let contacts = contact_frames(m);
     for &(f, side) in &contacts {
@@ -357,25 +362,7 @@ fn the_stops_last_half_step_does_not_regress() {
     ];
     let mut failures = Vec::new();
     for &(kmh, h, measured) in cases {
-        let opts = WalkOptions {
-            height_m: h,
-            stop: true,
-            ..Default::default()
-        };
-        let schedule = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps: 6,
-        }];
-        let (m, _) = generate_walk(&schedule, &opts).unwrap();
-        let hs: Vec<f64> = m
-            .events
-            .iter()
-            .filter(|e| e.kind == EventKind::HeelStrike)
-            .map(|e| e.time_s * m.fps())
-            .collect();
+        let (m, hs) = six_steps_to_a_stop(kmh, h, false);
         let n = hs.len();
         assert!(n >= 4, "{kmh} km/h {h} m: {n} heel strikes");
         let region = hs[n - 3].ceil() as usize..hs[n - 2].ceil() as usize;

@@ -19,9 +19,29 @@
 //!   1 cm tolerance the toe, which rises tangentially and is held only 5 mm (the toe-clearance
 //!   attribute) above the ground early in slow swings, is never seen leaving.
 use gaitfit::events::{steps_from_trial, EventOptions, Gait, PrimarySource};
+use gaitfit::generator::motion::Motion;
 use gaitfit::generator::walking::high_level::phase_times;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
+use gaitfit::generator::walking::{
+    generate_walk, ScheduleEntry, WalkOptions, WalkParams, WalkReport,
+};
 use gaitfit::ingest::trials::StepRow;
+
+/// A steady walk of `steps` steps at `kmh` and height `h`, with its options and report.
+fn steady_walk(kmh: f64, h: f64, steps: usize) -> (WalkOptions, Motion, WalkReport) {
+    let opts = WalkOptions {
+        height_m: h,
+        ..Default::default()
+    };
+    let sched = [ScheduleEntry {
+        params: WalkParams {
+            speed_m_per_s: Some(kmh / 3.6),
+            ..Default::default()
+        },
+        steps,
+    }];
+    let (m, r) = generate_walk(&sched, &opts).unwrap();
+    (opts, m, r)
+}
 
 #[test]
 fn detection_recovers_step_length_frequency_and_double_support() {
@@ -41,18 +61,7 @@ fn detection_recovers_step_length_frequency_and_double_support() {
     heights.phases.height_tol_m = 1e-3;
     heights.kinematic.cutoff_hz = 45.0;
     for (kmh, h) in [(1.5, 1.6), (3.0, 1.7), (5.0, 1.8), (7.0, 1.95)] {
-        let opts = WalkOptions {
-            height_m: h,
-            ..Default::default()
-        };
-        let sched = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps: 10,
-        }];
-        let (m, r) = generate_walk(&sched, &opts).unwrap();
+        let (opts, m, r) = steady_walk(kmh, h, 10);
         let sl = r.steps[0].step_length_m;
         let sf = r.steps[0].step_freq_steps_per_min / 60.0;
         let t_ds = phase_times(r.steps[0].step_freq_steps_per_min, &opts.relations).double_support;
@@ -130,18 +139,7 @@ fn toe_leaves_briskly_and_the_knee_decelerates_into_the_lock() {
     use gaitfit::events::{EventKind, Side};
     use gaitfit::generator::skeleton::{Joint, Landmark};
     for (kmh, h) in [(1.5, 1.6), (3.0, 1.7), (5.0, 1.8), (7.0, 1.95)] {
-        let opts = WalkOptions {
-            height_m: h,
-            ..Default::default()
-        };
-        let sched = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps: 8,
-        }];
-        let (m, _) = generate_walk(&sched, &opts).unwrap();
+        let (_, m, _) = steady_walk(kmh, h, 8);
         let v = kmh / 3.6;
         let fps = m.fps();
         let toe_offs: Vec<_> = m

@@ -306,6 +306,24 @@ fn the_cli_stop_ends_with_the_trailing_foot_landing() {
     );
 }
 
+/// The hip, knee, ankle and heel landmarks of one side's leg.
+fn leg(side: Side) -> (Landmark, Landmark, Landmark, Landmark) {
+    match side {
+        Side::Left => (
+            Landmark::LHip,
+            Landmark::LKnee,
+            Landmark::LAnkle,
+            Landmark::LHeel,
+        ),
+        Side::Right => (
+            Landmark::RHip,
+            Landmark::RKnee,
+            Landmark::RAnkle,
+            Landmark::RHeel,
+        ),
+    }
+}
+
 /// Walks of 6 steps from standing to a stop at `v` km/h and height `h`.
 fn from_standing(v: f64, h: f64) -> Motion {
     let opts = WalkOptions {
@@ -445,20 +463,7 @@ fn the_first_swing_from_standing_leaves_with_its_thigh_behind_its_landing_angle(
         let first = |kind: EventKind| m.events.iter().find(|e| e.kind == kind).unwrap();
         let (toe_off, hs) = (first(EventKind::ToeOff), first(EventKind::HeelStrike));
         assert_eq!(toe_off.side, hs.side);
-        let (hip, knee, ankle, heel) = match toe_off.side {
-            Side::Left => (
-                Landmark::LHip,
-                Landmark::LKnee,
-                Landmark::LAnkle,
-                Landmark::LHeel,
-            ),
-            Side::Right => (
-                Landmark::RHip,
-                Landmark::RKnee,
-                Landmark::RAnkle,
-                Landmark::RHeel,
-            ),
-        };
+        let (hip, knee, ankle, heel) = leg(toe_off.side);
         let thigh = |f: usize| {
             let (h, k) = (m.landmark(f, hip), m.landmark(f, knee));
             (h.x - k.x).atan2(h.y - k.y)
@@ -517,20 +522,7 @@ fn the_second_swing_from_standing_leaves_from_its_toes() {
             .nth(1)
             .unwrap();
         let f = (toe_off.time_s * m.fps()).floor() as usize;
-        let (hip, knee, ankle, heel) = match toe_off.side {
-            Side::Left => (
-                Landmark::LHip,
-                Landmark::LKnee,
-                Landmark::LAnkle,
-                Landmark::LHeel,
-            ),
-            Side::Right => (
-                Landmark::RHip,
-                Landmark::RKnee,
-                Landmark::RAnkle,
-                Landmark::RHeel,
-            ),
-        };
+        let (hip, knee, ankle, heel) = leg(toe_off.side);
         let p = |l: Landmark| m.landmark(f, l);
         let thigh = (p(hip) - p(knee)).normalize();
         let shank = (p(knee) - p(ankle)).normalize();
