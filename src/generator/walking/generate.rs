@@ -1473,6 +1473,29 @@ fn reachable_landing_roll(leg: &VirtualLeg, hip: [f64; 2], dz: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// The arm lag is a first-order lag of time constant `ARM_LAG`, independent of the frame
+    /// rate, per arm; faded out (`settle` = 1) the arm copies the thigh.
+    #[test]
+    fn arm_lag_is_a_first_order_lag_that_fades_out() {
+        for fps in [100.0, 120.0, 250.0] {
+            let mut lag = ArmLag::new(fps);
+            assert_eq!(lag.follow(Side::Left, 0.0), 0.0);
+            assert_eq!(lag.follow(Side::Right, -0.5), -0.5);
+            // A unit step of the left thigh: after ARM_LAG the arm is 1 − 1/e of the way there.
+            let n = (ARM_LAG * fps).round() as usize;
+            let mut y = 0.0;
+            for _ in 0..n {
+                y = lag.follow(Side::Left, 1.0);
+            }
+            let expected = 1.0 - (-(n as f64) / (fps * ARM_LAG)).exp();
+            assert!((y - expected).abs() < 1e-12, "{fps} fps: {y} vs {expected}");
+            // The other arm kept its own state.
+            assert_eq!(lag.follow(Side::Right, -0.5), -0.5);
+            lag.settle = 1.0;
+            assert_eq!(lag.follow(Side::Left, 0.3), 0.3);
+        }
+    }
+
     #[test]
     fn swing_hip_offset_matches_the_pelvis_rotation() {
         for swing in [Side::Left, Side::Right] {
