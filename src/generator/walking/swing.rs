@@ -26,7 +26,10 @@ use super::foot::{smoothstep, FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_1d, solve_2d, Solved};
 use super::track::{Node, Track};
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
+use std::hash::{BuildHasherDefault, Hasher};
 
 /// Everything that defines one swing phase.
 #[derive(Clone, Copy)]
@@ -681,6 +684,21 @@ impl SwingSpec<'_> {
         guess: [f64; 7],
         speed: f64,
     ) -> Result<SwingRun, String> {
+        // Every shooting simulation of a subphase integrates over the same fixed step grid, so
+        // the hip is read at the same instants again and again (interpolating the stance track
+        // and the determinants' offsets was ≈ a quarter of the walk's time): memoized by the
+        // exact time. The hip is a pure function of t, so the results are bit-identical.
+        let memo = HipMemo::new(self.hip);
+        let hip = |t: f64| memo.at(t);
+        SwingSpec { hip: &hip, ..*self }.solve_memo(start, guess, speed)
+    }
+
+    fn solve_memo(
+        &self,
+        start: &SwingStart,
+        guess: [f64; 7],
+        speed: f64,
+    ) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
         // Stability bound from swing2's spring–damper (the stiffest subphase).
         let mut jf = |t: f64, y: &[f64; 4]| {
@@ -894,6 +912,50 @@ impl SwingSpec<'_> {
             curve,
             track,
         })
+    }
+}
+
+/// Memo of a pure hip motion `t ↦ HipMotion`, keyed by the exact bits of `t`.
+struct HipMemo<'a> {
+    hip: &'a dyn Fn(f64) -> HipMotion,
+    seen: RefCell<HashMap<u64, HipMotion, BuildHasherDefault<TimeHasher>>>,
+}
+
+impl<'a> HipMemo<'a> {
+    fn new(hip: &'a dyn Fn(f64) -> HipMotion) -> Self {
+        Self {
+            hip,
+            seen: RefCell::new(HashMap::with_capacity_and_hasher(4096, Default::default())),
+        }
+    }
+
+    fn at(&self, t: f64) -> HipMotion {
+        if let Some(m) = self.seen.borrow().get(&t.to_bits()) {
+            return *m;
+        }
+        let m = (self.hip)(t);
+        self.seen.borrow_mut().insert(t.to_bits(), m);
+        m
+    }
+}
+
+/// A multiplicative hash of one `u64` (the memo's keys are times: SipHash's DoS resistance is
+/// not needed and costs as much as the lookup saves).
+#[derive(Default)]
+struct TimeHasher(u64);
+
+impl Hasher for TimeHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ u64::from(b)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        let h = (x ^ self.0).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        self.0 = h ^ (h >> 29);
     }
 }
 
