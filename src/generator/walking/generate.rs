@@ -299,9 +299,20 @@ const CONTACT_RATE_WINDOW: f64 = 0.01;
 /// take it up, so the foot must roll about the heel), while the swing foot used to arrive with
 /// its ankle at rest — a one-frame spike of the ankle's rotation (continuity ratios 10–20).
 /// Matching the rate in full would need the swing ankle to dorsiflex 5–8° and snap back at
-/// 9–15 rad/s in the last 60 ms before contact, which no walker does; 3 rad/s keeps that bump
-/// below 2° (human ankles plantarflex at a few rad/s through loading response).
-pub const MAX_CONTACT_ANKLE_RATE: f64 = 3.0;
+/// 9–15 rad/s in the last 60 ms before contact, which no walker does.
+///
+/// 6 rad/s (was 3; klawhs, issue 6): the top of a human ankle's plantarflexion rate in loading
+/// response at brisk walking speeds, reached only at the contact (swing3's cubic, see
+/// `SwingFoot::theta56`); the ankle first dorsiflexes ≈ 1.5° more than the paper's
+/// interpolation in swing3 (5 km/h, 1.8 m: 0.027 rad, against ≈ 0.01 at 3 rad/s). The three
+/// frames before the contact then carry part of the stance foot's roll, so the landing ankle's
+/// steps rise into the contact instead of jumping (worst ratio, 8 steps, 1.5/1.8/2.0 m: 4 km/h
+/// 6.98/4.73/4.33 → 6.58/4.22/3.31, 5 km/h 9.92/6.01/5.26 → 9.29/4.74/4.31 — 1.8 and 2.0 m now
+/// meet k = 5 —, 6 km/h 11.3/7.96/10.5 → 10.7/6.46/10.5, 7 km/h 12.4/10.8/7.82 →
+/// 11.0/10.2/6.15; frame 0 of a steady start, which has no pre-contact frames, is now the worst
+/// at 4–6 km/h and is unchanged). 10 rad/s took 7 km/h × 1.8 m's heel strikes further (≤ 7.2)
+/// but is beyond what a human ankle does just before contact; not taken.
+pub const MAX_CONTACT_ANKLE_RATE: f64 = 6.0;
 
 /// How much later (fraction of the swing) swing1 ends in the last step before a stop, a half
 /// step whose swing foot travels 1.5 step lengths to a heel strike only half a step ahead.
