@@ -87,6 +87,7 @@ fn continuity_ratios_do_not_regress() {
         (&[(3.0, 8)], 1.8, false, BOUND_3KMH),
         (&[(5.0, 8)], 1.8, false, BOUND_5KMH),
         (&[(7.0, 8)], 1.8, false, BOUND_7KMH),
+        (&[(6.0, 8)], 2.0, false, BOUND_6KMH_2M),
         (&[(2.0, 4), (5.0, 4), (3.0, 4)], 1.8, true, BOUND_SCHEDULE),
     ];
     let mut failures = Vec::new();
@@ -118,6 +119,10 @@ const BOUND_3KMH: f64 = 4.8; // measured 3.80 (frame 44, r_knee): k = 5 met
 // 10.8 → 10.2 (frame 0; the heel strikes ≤ 8.5).
 const BOUND_5KMH: f64 = 5.9; // measured 4.74 (frame 0, l_ankle; 6.06 at frame 56, r_ankle, heel strike, before the contact rate 6; 8.53 at frame 0 before the push-off)
 const BOUND_7KMH: f64 = 12.7; // measured 10.20 (frame 0, l_ankle; 10.57–10.8 at frame 283, l_ankle, heel strike, before the contact rate 6; 16.1 at frame 0 before the push-off)
+// klawfirst2 (`hold_knees`: the trailing knee no longer straightens again around heel strike):
+// 6 km/h × 2.0 m 10.5 (frame 0, r_knee: the trailing knee's straightening at the walk's first
+// heel strike, with nothing before it in the window; 6.09 before the brisk toe off) → 6.07.
+const BOUND_6KMH_2M: f64 = 7.6; // measured 6.07 (frame 161, r_ankle, heel strike)
 const BOUND_SCHEDULE: f64 = 7.2; // measured 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
 
 /// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
@@ -282,6 +287,83 @@ fn the_start_and_the_stop_do_not_regress() {
                 failures.push(format!(
                     "{kmh} km/h {h} m from standing {rest}, {what}: {:.1} > 1.25 × {measured}",
                     r.worst
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Knee flexion (rad) of `joint`'s local rotation per frame: its rotation angle.
+fn joint_angles(m: &Motion, joint: Joint) -> Vec<f64> {
+    let ji = joint.index();
+    m.poses()
+        .iter()
+        .map(|p| {
+            let r = p.rotations[ji];
+            2.0 * r.xyz().length().atan2(r.w.abs())
+        })
+        .collect()
+}
+
+/// The trailing knee flexes steadily through the double support (klawfirst2, `hold_knees`): from
+/// each heel strike to the other foot's toe off it never straightens by more than 1 mrad in a
+/// frame (the continuity floor; measured ≤ 0.46 mrad). It used to straighten by 0.01 rad in the frame after heel strike (≈ 1 rad/s, undoing
+/// the flexion the smoothed heel-off roll put there before heel strike) and then rest until its
+/// meta-off flexion — at the recorded walk's first frame a ratio of 10.5 (6 km/h × 2.0 m). Steady
+/// walks of 8 steps, 3–7 km/h × 1.5/1.8/2.0 m.
+#[test]
+fn the_trailing_knee_does_not_straighten_in_double_support() {
+    let mut failures = Vec::new();
+    for kmh in [3.0, 5.0, 6.0, 7.0] {
+        for h in [1.5, 1.8, 2.0] {
+            let opts = WalkOptions {
+                height_m: h,
+                ..Default::default()
+            };
+            let schedule = [ScheduleEntry {
+                params: WalkParams {
+                    speed_m_per_s: Some(kmh / 3.6),
+                    ..Default::default()
+                },
+                steps: 8,
+            }];
+            let (m, _) = generate_walk(&schedule, &opts).unwrap();
+            let fps = m.fps();
+            let mut worst = (0.0f64, 0usize);
+            for hs in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
+                let trailing = hs.side.opposite();
+                let Some(to) = m.events.iter().find(|e| {
+                    e.kind == EventKind::ToeOff && e.side == trailing && e.time_s > hs.time_s
+                }) else {
+                    continue;
+                };
+                let knee = joint_angles(
+                    &m,
+                    match trailing {
+                        gaitfit::events::Side::Left => Joint::LKnee,
+                        gaitfit::events::Side::Right => Joint::RKnee,
+                    },
+                );
+                let (a, b) = (
+                    (hs.time_s * fps).floor() as usize,
+                    ((to.time_s * fps).floor() as usize).min(knee.len() - 1),
+                );
+                for f in a..b {
+                    let straighten = knee[f] - knee[f + 1];
+                    if straighten > worst.0 {
+                        worst = (straighten, f);
+                    }
+                }
+            }
+            println!(
+                "{kmh} km/h {h} m: trailing knee straightens at most {:.5} rad/frame (frame {})",
+                worst.0, worst.1
+            );
+            if worst.0 > 1e-3 {
+                failures.push(format!(
+                    "{kmh} km/h {h} m: {:.5} at frame {}",
+                    worst.0, worst.1
                 ));
             }
         }

@@ -245,9 +245,15 @@ struct StepData {
     swing_times: [f64; 4],
     /// Virtual-leg roll samples of the stance leg over the step (time from step start, ρ).
     stance_rho: Vec<(f64, f64)>,
+    /// The stance leg's hip (sagittal x, y) and lateral offset from its foot at each
+    /// `stance_rho` sample.
+    stance_hips: Vec<([f64; 2], f64)>,
     stance_leg: VirtualLeg,
     /// Trailing leg over the double support.
     trail_rho: Vec<(f64, f64)>,
+    /// The trailing leg's hip (sagittal x, y) and lateral offset from its foot at each
+    /// `trail_rho` sample.
+    trail_hips: Vec<([f64; 2], f64)>,
 
     trail_leg: VirtualLeg,
     /// Global time of the trailing leg's clock origin, s.
@@ -578,6 +584,7 @@ pub fn generate_steps(
         trailing.toe_off_knee_rate = toe_off_rate(kk);
         trailing.min_knee_blend = MIN_KNEE_BLEND * t_ds;
         let mut trail_rho = Vec::new();
+        let mut trail_hips = Vec::new();
         let n_v = ((t_ds / dt_v).ceil() as usize).max(3);
         let zf_w = side_z(swing_side, a);
         // From standing, the first two trailing legs leave from their toes, as at every steady
@@ -616,6 +623,7 @@ pub fn generate_steps(
             let (hp, hz) = swing_hip3(t);
             let p = trailing.advance(trailing_clock + t, hp, hz - zf_w);
             trail_rho.push((t, p.rho));
+            trail_hips.push((hp, hz - zf_w));
             trail_poses.push((t, p, hp));
         }
         let trail_leg = trailing.clone();
@@ -815,8 +823,10 @@ pub fn generate_steps(
                 knee_brake: sspec.knee_brake,
                 swing_times,
                 stance_rho,
+                stance_hips: hips.iter().map(|&(_, hp, dz)| (hp, dz)).collect(),
                 stance_leg: stance_leg.clone(),
                 trail_rho,
+                trail_hips,
                 trail_leg,
                 trail_origin: t_global - trailing_clock,
             });
@@ -834,6 +844,7 @@ pub fn generate_steps(
         from_rest = false;
     }
     smooth_rolls(&mut data, pre_stance);
+    hold_knees(&mut data);
     // The stop: the trailing foot is brought alongside and the body comes to rest.
     let closing = match (opt.stop, data.last()) {
         (true, Some(d)) => {
@@ -981,6 +992,179 @@ fn smooth_rolls(data: &mut [StepData], pre: Option<(f64, Vec<(f64, f64)>)>) {
                 } else {
                     rho[n1 + i - skipped]
                 };
+            }
+        }
+    }
+}
+
+/// Keeps every leg's knee from straightening again between heel off and toe off: wherever the
+/// smoothed roll would draw it less flexed than it already was since heel off, the foot rolls
+/// on (about the ball or the toe tip, so nothing slides or sinks) until the knee is as flexed
+/// as it was. A leg's late stance is recorded in two steps (its own stance, then the next
+/// step's double support), so the two are joined. The toe-off samples (the last two, where the
+/// swing takes over with their state) are kept; if the hold would need them, the leg is left
+/// as it was.
+///
+/// Why: the heel-off rule's roll accelerates through late stance with the push-off and
+/// flattens at heel strike, where the push-off ends; the least-bending roll above the rule
+/// ([`smooth_roll`]) rounds that corner by rolling a little ahead of the rule before heel
+/// strike and rejoining it within 1–2 frames after — drawn as a knee that flexes ≈ 0.012 rad
+/// and straightens back at ≈ 1.2 rad/s around heel strike, before its meta-off flexion
+/// (6 km/h × 2.0 m: the recorded walk's first frame is that heel strike, with nothing before
+/// it in the continuity window: ratio 10.5 on the trailing knee; 5.3–6.5 at later heel
+/// strikes). A person's trailing knee flexes steadily from heel off to toe off.
+/// Time scale of the held knee's smoothing ([`hold_knees`]), s.
+const KNEE_HOLD_TAU: f64 = 0.03;
+
+fn hold_knees(data: &mut [StepData]) {
+    /// One leg's late stance: its samples (step, in the trail part, index) in time order, the
+    /// trail samples at the same time as the stance's last (drawn with its roll), and whether
+    /// the hold starts at the first sample (the recorded walk's first trailing leg: its
+    /// history before the walk is not here).
+    struct Chain {
+        samples: Vec<(usize, bool, usize)>,
+        same_time: Vec<(usize, usize)>,
+        from_first: bool,
+    }
+    let mut chains: Vec<Chain> = Vec::new();
+    if let Some(d) = data.first() {
+        let heel_off = d.trail_leg.transitions[1].map_or(f64::INFINITY, |t| d.trail_origin + t);
+        chains.push(Chain {
+            samples: (0..d.trail_rho.len().min(d.trail_hips.len()))
+                .filter(|&i| d.start + d.trail_rho[i].0 >= heel_off - 1e-9)
+                .map(|i| (0, true, i))
+                .collect(),
+            same_time: Vec::new(),
+            from_first: true,
+        });
+    }
+    for k in 0..data.len().saturating_sub(1) {
+        let (d, n) = (&data[k], &data[k + 1]);
+        let heel_off = d.stance_leg.transitions[1]
+            .map(|t| d.start + t)
+            .or_else(|| n.trail_leg.transitions[1].map(|t| n.trail_origin + t))
+            .unwrap_or(f64::INFINITY);
+        let mut samples: Vec<(usize, bool, usize)> =
+            (0..d.stance_rho.len().min(d.stance_hips.len()))
+                .filter(|&i| d.start + d.stance_rho[i].0 >= heel_off - 1e-9)
+                .map(|i| (k, false, i))
+                .collect();
+        let mut same_time = Vec::new();
+        let mut last = samples
+            .last()
+            .map_or(f64::NEG_INFINITY, |&(_, _, i)| d.start + d.stance_rho[i].0);
+        for i in 0..n.trail_rho.len().min(n.trail_hips.len()) {
+            let g = n.start + n.trail_rho[i].0;
+            if g < heel_off - 1e-9 {
+                continue;
+            }
+            if g <= last + 1e-12 {
+                same_time.push((k + 1, i));
+                continue;
+            }
+            last = g;
+            samples.push((k + 1, true, i));
+        }
+        chains.push(Chain {
+            samples,
+            same_time,
+            from_first: false,
+        });
+    }
+    fn sample<'a>(
+        data: &'a [StepData],
+        &(k, trail, i): &(usize, bool, usize),
+    ) -> (&'a VirtualLeg, [f64; 2], f64, f64) {
+        let d = &data[k];
+        let (leg, (hip, dz), r) = if trail {
+            (&d.trail_leg, d.trail_hips[i], d.trail_rho[i].1)
+        } else {
+            (&d.stance_leg, d.stance_hips[i], d.stance_rho[i].1)
+        };
+        (leg, hip, dz, r)
+    }
+    for c in chains {
+        let knees: Vec<f64> = c
+            .samples
+            .iter()
+            .map(|s| {
+                let (leg, hip, dz, r) = sample(data, s);
+                leg.pose_at(hip, dz, r).knee
+            })
+            .collect();
+        // From the knee's last straightest sample before heel strike (within 0.1 mrad): the
+        // heel-off rule may begin while the knee still straightens from loading response, and
+        // may straighten it with a kink of its own (3 km/h), which the hold would only sharpen.
+        let n_stance = c.samples.iter().take_while(|s| !s.1).count();
+        let k_min = knees[..n_stance]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        let i0 = if c.from_first {
+            Some(0)
+        } else {
+            knees[..n_stance].iter().rposition(|&k| k <= k_min + 1e-4)
+        };
+        let Some(i0) = i0 else {
+            continue;
+        };
+        let chain = &c.samples[i0..];
+        if chain.len() < 4 {
+            continue;
+        }
+        // The knee to draw: the running maximum of the drawn knee, then the least-bending
+        // curve above it (`smooth_roll` on the knee, the toe-off samples kept): a knee that
+        // flexes steadily instead of in a short burst followed by a hold.
+        let times: Vec<f64> = chain
+            .iter()
+            .map(|&(k, trail, i)| {
+                let d = &data[k];
+                d.start
+                    + if trail {
+                        d.trail_rho[i].0
+                    } else {
+                        d.stance_rho[i].0
+                    }
+            })
+            .collect();
+        let mut floor: Vec<f64> = knees[i0..]
+            .iter()
+            .scan(f64::NEG_INFINITY, |m, &k| {
+                *m = k.max(*m);
+                Some(*m)
+            })
+            .collect();
+        smooth_roll(&times, &mut floor, 0, false, KNEE_HOLD_TAU);
+        let mut held = vec![sample(data, &chain[0]).3];
+        let mut ok = true;
+        for (j, s) in chain.iter().enumerate().skip(1) {
+            let (leg, hip, dz, r) = sample(data, s);
+            let r = r.max(held[j - 1]);
+            if leg.pose_at(hip, dz, r).knee < floor[j] - 1e-9 {
+                if j + 2 >= chain.len() {
+                    ok = false;
+                    break;
+                }
+                held.push(leg.roll_for_knee(hip, dz, r, floor[j]));
+            } else {
+                held.push(r);
+            }
+        }
+        if !ok {
+            continue;
+        }
+        let mut stance_last = None;
+        for (&(k, trail, i), &r) in chain.iter().zip(&held) {
+            if trail {
+                data[k].trail_rho[i].1 = r;
+            } else {
+                data[k].stance_rho[i].1 = r;
+                stance_last = Some(r);
+            }
+        }
+        if let Some(r) = stance_last {
+            for &(k, i) in &c.same_time {
+                data[k].trail_rho[i].1 = r;
             }
         }
     }

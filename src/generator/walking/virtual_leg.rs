@@ -470,6 +470,20 @@ impl VirtualLeg {
         }
     }
 
+    /// The least roll `ρ ≥ from` at which the leg, hip at `hip` with lateral offset `dz`, spans
+    /// no more than a knee flexion of `knee` does (the foot rolls on until the knee is at least
+    /// that flexed); `from` itself when it already is.
+    pub fn roll_for_knee(&self, hip: [f64; 2], dz: f64, from: f64, knee: f64) -> f64 {
+        let d_target = span_for(self.l3, self.l4, knee);
+        let g = |r: f64| {
+            let p = self.pose_at(hip, dz, r);
+            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
+            (hip[0] - p.ankle[0]).hypot(dy) - d_target
+        };
+        let cap = (self.theta6_max + RHO_CAP).max(from);
+        self.smallest(from, cap, g)
+    }
+
     /// Finds the first `ρ ≥ lo` (continuing from `lo`, the previous roll) with `g(ρ) ≤ 0`: a
     /// scan in small increments, then bisection inside the increment — `g` need not be monotone,
     /// and the roll never jumps to a distant root.
