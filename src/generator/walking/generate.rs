@@ -13,7 +13,7 @@ use super::foot::{smoothstep, FootShape};
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::stop::{Closing, StopStart};
-use super::swing::{SwingRun, SwingSpec, SwingStart};
+use super::swing::{SwingCarry, SwingRun, SwingSpec, SwingStart};
 use super::virtual_leg::{
     smooth_roll, FootPeriod, LegPose, VirtualLeg, KNEE_SOFT, TOE_OFF_KNEE_RATE,
 };
@@ -459,7 +459,9 @@ pub fn generate_steps(
         trailing.period = FootPeriod::HeelOff;
     }
     let mut stance_guess = [0.0, 0.0];
+    let mut stance_jac = None;
     let mut swing_guess = [0.0; 7];
+    let mut swing_carry = SwingCarry::default();
     let mut recovery_by_leg = [0.0f64; 2];
     let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
         .chain(steps.iter().copied())
@@ -544,9 +546,10 @@ pub fn generate_steps(
             },
         };
         let (st_solved, st_run) = spec
-            .solve(&stance_start, stance_guess)
+            .solve_with(&stance_start, stance_guess, stance_jac)
             .map_err(|e| num_err(stage("stance shooting"), e))?;
         stance_guess = st_solved.x;
+        stance_jac = st_solved.jacobian.or(stance_jac);
         let ax = ankle_x[idx(stance_side)];
         let track = st_run.track.clone();
         let dyn_hip = move |t: f64| -> HipMotion {
@@ -754,9 +757,10 @@ pub fn generate_steps(
         // walks alternate between legs (period-two pattern of the recovery).
         swing_guess[4] = recovery_by_leg[idx(swing_side)];
         let sw = sspec
-            .solve(&swing_start, swing_guess, l.speed_m_per_s)
+            .solve_with(&swing_start, swing_guess, &swing_carry, l.speed_m_per_s)
             .map_err(|e| num_err(stage("swing shooting"), e))?;
         swing_guess = sw.params;
+        swing_carry = sw.carry;
         recovery_by_leg[idx(swing_side)] = sw.params[4];
         // 5. Heel strike.
         let last = *sw

@@ -53,7 +53,7 @@
 use super::dynamics::{solve2, StanceModel};
 use super::foot::smoothstep;
 use super::integrate::{integrate, spectral_radius, stable_step};
-use super::shooting::{solve_2d, Solved};
+use super::shooting::{solve_2d_with, Solved};
 use super::track::{Node, Track};
 
 /// Half-width of the kinematic blend that spreads the lock's rate jump, s (the leg is drawn
@@ -394,10 +394,31 @@ impl StanceSpec {
         start: &StanceStart,
         guess: [f64; 2],
     ) -> Result<(Solved<2>, StanceRun), String> {
+        self.solve_with(start, guess, None)
+    }
+
+    /// [`StanceSpec::solve`] starting the Broyden iteration from a carried Jacobian (the previous
+    /// step's [`Solved::jacobian`]) instead of a finite-difference one.
+    pub fn solve_with(
+        &self,
+        start: &StanceStart,
+        guess: [f64; 2],
+        jacobian: Option<[[f64; 2]; 2]>,
+    ) -> Result<(Solved<2>, StanceRun), String> {
         let h = self.step(start);
+        // The residual at the guess is needed twice (to judge it, then as the solve's first
+        // evaluation): the last evaluation is kept rather than simulated again.
+        let last = std::cell::Cell::new(None::<([f64; 2], [f64; 2])>);
         let f = |x: [f64; 2]| {
+            if let Some((xl, rl)) = last.get() {
+                if xl == x {
+                    return rl;
+                }
+            }
             let r = self.run(start, x[0], x[1], h, false);
-            [r.end[1] - self.target[1], r.end[0] - self.target[0]]
+            let r = [r.end[1] - self.target[1], r.end[0] - self.target[0]];
+            last.set(Some((x, r)));
+            r
         };
         // Without a previous step's profile (the walk's first step), or when that profile is far
         // off for this step's start (the pendulum falls: the residual saturates and the Jacobian
@@ -408,6 +429,8 @@ impl StanceSpec {
             let r = f(guess);
             !(r[0].abs() < 0.2 && r[1].abs() < 0.05)
         };
+        // A coarse scan's start is far from where the carried Jacobian was taken.
+        let jacobian = if far { None } else { jacobian };
         let guess = if far {
             let scale = (self.model.m1 + self.model.m2) * self.model.g * self.l1;
             let mut best = (f64::INFINITY, guess);
@@ -422,7 +445,7 @@ impl StanceSpec {
         } else {
             guess
         };
-        let solved = solve_2d(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 160)?;
+        let solved = solve_2d_with(f, guess, [2.0, 1e-3], [1e-7, 1e-7], 160, jacobian)?;
         let run = self.run(start, solved.x[0], solved.x[1], h, true);
         Ok((solved, run))
     }

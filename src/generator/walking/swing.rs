@@ -24,7 +24,7 @@ use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
 use super::foot::{smoothstep, FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
-use super::shooting::{solve_1d, solve_2d, Solved};
+use super::shooting::{solve_1d, solve_1d_with, solve_2d_with, Solved};
 use super::track::{Node, Track};
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -269,6 +269,24 @@ impl AnkleCurve {
     }
 }
 
+/// Solver state carried from one step's swing to the next (like the force profiles
+/// [`SwingRun::params`]): with it a steady walk's two-unknown solves start next to their
+/// solution with a usable Jacobian.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SwingCarry {
+    /// Last slope of swing1's residual in its torque `A` (rad per N·m).
+    pub swing1_slope: Option<f64>,
+    /// Last (Broyden-updated) Jacobian of swing2's solve for the knee torque and brake `(B, E)`.
+    pub swing2_jacobian: Option<[[f64; 2]; 2]>,
+    /// The recovery actuator (rad) at which swing2's `(B, E)` of [`SwingRun::params`] was found.
+    pub swing2_recovery: f64,
+    /// Change of swing2's `(B, E)` per recovery grid step ([`RECOVERY_STEP`]), from the last two
+    /// grid points solved in one step: moves the start of a solve to the grid point it is for.
+    pub swing2_per_grid_step: Option<[f64; 2]>,
+    /// Last Jacobian of swing3's solve for `(C, D)`.
+    pub swing3_jacobian: Option<[[f64; 2]; 2]>,
+}
+
 /// Outcome of a simulated swing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SwingRun {
@@ -281,6 +299,8 @@ pub struct SwingRun {
     /// [`KNEE_BRAKE_POWER`]) and swing3's ramp `D` (see [`SwingSpec::theta3_rate_hs`]); the
     /// next step starts from them.
     pub params: [f64; 7],
+    /// What the next step's [`SwingSpec::solve_with`] starts its solves from besides `params`.
+    pub carry: SwingCarry,
     /// Final position actuator of the stubbing recovery, rad (0 if not needed).
     pub recovery: f64,
     /// Recovery rounds used.
@@ -684,19 +704,32 @@ impl SwingSpec<'_> {
         guess: [f64; 7],
         speed: f64,
     ) -> Result<SwingRun, String> {
+        self.solve_with(start, guess, &SwingCarry::default(), speed)
+    }
+
+    /// [`SwingSpec::solve`] also starting swing2's and swing3's two-unknown solves from the
+    /// previous step's solver state (its [`SwingRun::carry`]).
+    pub fn solve_with(
+        &self,
+        start: &SwingStart,
+        guess: [f64; 7],
+        carry: &SwingCarry,
+        speed: f64,
+    ) -> Result<SwingRun, String> {
         // Every shooting simulation of a subphase integrates over the same fixed step grid, so
         // the hip is read at the same instants again and again (interpolating the stance track
         // and the determinants' offsets was ≈ a quarter of the walk's time): memoized by the
         // exact time. The hip is a pure function of t, so the results are bit-identical.
         let memo = HipMemo::new(self.hip);
         let hip = |t: f64| memo.at(t);
-        SwingSpec { hip: &hip, ..*self }.solve_memo(start, guess, speed)
+        SwingSpec { hip: &hip, ..*self }.solve_memo(start, guess, carry, speed)
     }
 
     fn solve_memo(
         &self,
         start: &SwingStart,
         guess: [f64; 7],
+        carry: &SwingCarry,
         speed: f64,
     ) -> Result<SwingRun, String> {
         let [t0, t1, t2, _] = self.times;
@@ -723,16 +756,19 @@ impl SwingSpec<'_> {
         let mut it1 = 0;
         let mut a_guess = guess[0];
         let mut lift_rounds = 0;
+        let mut slope1 = carry.swing1_slope;
         let (a1, curve, mut track, y1) = loop {
             let curve = self.curve(start, speed, extra)?;
-            let s1 = solve_1d(
+            let s1 = solve_1d_with(
                 |a| self.swing1(start, &curve, a, tau1, h, None)[0] - self.theta3_hs,
                 a_guess,
                 0.5 * scale,
                 TOL,
                 60,
+                slope1,
             )
             .map_err(|e| format!("swing1: {e}"))?;
+            slope1 = s1.jacobian.map(|j| j[0][0]).or(slope1);
             it1 += s1.iterations;
             let mut track = Track::default();
             let y1 = self.swing1(start, &curve, s1.x[0], tau1, h, Some(&mut track));
@@ -770,19 +806,41 @@ impl SwingSpec<'_> {
         let k_prev = (guess[4].max(0.0) / RECOVERY_STEP).round() as usize;
         let mut k = k_prev.saturating_sub(1).min(RECOVERY_MAX);
         let mut it2 = 0;
+        // The last solved (B, E) and its grid point (first: the previous step's), and the change
+        // of (B, E) per grid step: each solve starts from the last solution moved to its grid
+        // point (in a steady walk the two legs' actuators differ, and each step solves two
+        // neighbouring grid points).
         let mut b_guess = [guess[1], guess[5]];
+        let mut b_k = carry.swing2_recovery / RECOVERY_STEP;
+        let mut b_here = false;
+        let mut slope = carry.swing2_per_grid_step;
+        let mut jac2 = carry.swing2_jacobian;
         // Largest failing k and its clearance; least clear k and its solve.
         let mut fail_hi: Option<(usize, f64)> = None;
         let mut clear_lo = None;
         let mut best_fail = None;
         let (s2, lowest, rounds) = loop {
             let pa = k as f64 * RECOVERY_STEP;
+            let x0 = match slope {
+                Some(d) if self.knee_brake => {
+                    let dk = k as f64 - b_k;
+                    [b_guess[0] + dk * d[0], b_guess[1] + dk * d[1]]
+                }
+                _ => b_guess,
+            };
             // θ4(t2) = 0 and θ̇4(t2) = 0 (the rate scaled by swing2's duration, so both
             // residuals are angles): the knee comes to rest straight where it locks.
+            // The foot's lowest point of the last simulation: the solves end on an evaluation
+            // of the point they return (checked below), so no extra simulation is needed.
+            let mut last: Option<([f64; 2], f64)> = None;
             let s2 = if !self.knee_brake {
                 let s = solve_1d(
-                    |b| self.swing2(y2_0, [b, 0.0], pa, h, None).0[1],
-                    b_guess[0],
+                    |b| {
+                        let (y, low) = self.swing2(y2_0, [b, 0.0], pa, h, None);
+                        last = Some(([b, 0.0], low));
+                        y[1]
+                    },
+                    x0[0],
                     0.2 * scale,
                     TOL,
                     60,
@@ -792,23 +850,40 @@ impl SwingSpec<'_> {
                     x: [s.x[0], 0.0],
                     residual: [s.residual[0], 0.0],
                     iterations: s.iterations,
+                    jacobian: None,
                 }
             } else {
-                solve_2d(
+                // The Jacobian is carried from grid point to grid point and from step to step
+                // (Broyden-updated): a fresh finite-difference one cost two simulations per
+                // grid point.
+                let s = solve_2d_with(
                     |be| {
-                        let y = self.swing2(y2_0, be, pa, h, None).0;
+                        let (y, low) = self.swing2(y2_0, be, pa, h, None);
+                        last = Some((be, low));
                         [y[1], y[3] * (t2 - t1)]
                     },
-                    b_guess,
+                    x0,
                     [0.01 * scale, 0.01 * scale],
                     [TOL, TOL],
                     80,
+                    jac2,
                 )
-                .map_err(|e| format!("swing2: {e}"))?
+                .map_err(|e| format!("swing2: {e}"))?;
+                jac2 = s.jacobian.or(jac2);
+                s
             };
             it2 += s2.iterations;
-            let (_, lowest) = self.swing2(y2_0, s2.x, pa, h, None);
+            let lowest = match last {
+                Some((x, low)) if x == s2.x => low,
+                _ => self.swing2(y2_0, s2.x, pa, h, None).1,
+            };
+            if self.knee_brake && b_here && k as f64 != b_k {
+                let dk = k as f64 - b_k;
+                slope = Some([(s2.x[0] - b_guess[0]) / dk, (s2.x[1] - b_guess[1]) / dk]);
+            }
             b_guess = s2.x;
+            b_k = k as f64;
+            b_here = true;
             if lowest >= self.clearance {
                 clear_lo = Some((s2, lowest, k));
                 let below_fails = fail_hi.is_some_and(|(kf, _)| kf + 1 == k);
@@ -863,7 +938,7 @@ impl SwingSpec<'_> {
         // brake also a ramp `D` so that it lands at `theta3_rate_hs` (see that field).
         let t3 = self.times[3];
         let s3 = if self.knee_brake {
-            solve_2d(
+            solve_2d_with(
                 |cd| {
                     let y = self.swing3(y3_0, cd, h, None);
                     [
@@ -875,6 +950,7 @@ impl SwingSpec<'_> {
                 [0.01 * scale, 0.01 * scale],
                 [TOL, TOL],
                 80,
+                carry.swing3_jacobian,
             )
             .map_err(|e| format!("swing3: {e}"))?
         } else {
@@ -890,6 +966,7 @@ impl SwingSpec<'_> {
                 x: [s.x[0], 0.0],
                 residual: [s.residual[0], 0.0],
                 iterations: s.iterations,
+                jacobian: None,
             }
         };
         let y3 = self.swing3(y3_0, s3.x, h, Some(&mut track));
@@ -905,6 +982,13 @@ impl SwingSpec<'_> {
         Ok(SwingRun {
             iterations: [it1, it2, s3.iterations],
             params: [a1, s2.x[0], s3.x[0], extra, pa, s2.x[1], s3.x[1]],
+            carry: SwingCarry {
+                swing1_slope: slope1,
+                swing2_jacobian: jac2,
+                swing2_recovery: pa,
+                swing2_per_grid_step: slope,
+                swing3_jacobian: s3.jacobian.or(carry.swing3_jacobian),
+            },
             recovery: pa,
             recovery_rounds: rounds + lift_rounds,
             min_clearance,
