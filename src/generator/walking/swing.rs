@@ -280,7 +280,7 @@ pub struct SwingCarry {
     pub swing2_jacobian: Option<[[f64; 2]; 2]>,
     /// The recovery actuator (rad) at which swing2's `(B, E)` of [`SwingRun::params`] was found.
     pub swing2_recovery: f64,
-    /// Change of swing2's `(B, E)` per recovery grid step ([`RECOVERY_STEP`]), from the last two
+    /// Change of swing2's `(B, E)` per recovery grid step (0.02 rad of actuator), from the last two
     /// grid points solved in one step: moves the start of a solve to the grid point it is for.
     pub swing2_per_grid_step: Option<[f64; 2]>,
     /// Last Jacobian of swing3's solve for `(C, D)`.
