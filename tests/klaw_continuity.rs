@@ -262,10 +262,10 @@ fn the_start_and_the_stop_do_not_regress() {
         (1.0, 1.5, true, 5.6, 2.28), // start 113 r_heel, stop 684 l_knee; stop 2.6 before STOP_SWING2_ADVANCE
         (1.0, 1.8, true, 5.0, 3.4), // start 111 r_knee, stop 751 l_knee
         (1.0, 2.0, true, 4.1, 1.94), // start 117 r_knee, stop 793 l_knee; stop 2.1 before STOP_SWING2_ADVANCE
-        (2.0, 1.5, true, 4.9, 2.92), // start 80 r_knee, stop 482 l_heel; 6.1 before the rocker's landing scan; stop 4.1 before STOP_SWING2_ADVANCE
+        (2.0, 1.5, true, 4.12, 2.92), // start 72 r_hip (4.42 at 160 l_heel before FIRST_PAPER_SWINGS = 1), was 80 r_knee, stop 482 l_heel; 6.1 before the rocker's landing scan; stop 4.1 before STOP_SWING2_ADVANCE
         (2.0, 1.8, true, 4.1, 1.7), // start 176 l_knee, stop 560 r_metatarsal
         (2.0, 2.0, true, 4.4, 2.22), // start 185 l_heel (5.15 since the full first step), stop 557 l_heel; stop 2.4 before STOP_SWING2_ADVANCE
-        (3.0, 1.5, true, 4.4, 2.21), // start 58 l_shoulder, stop 395 l_ankle; stop 2.7 before STOP_SWING2_ADVANCE
+        (3.0, 1.5, true, 3.46, 2.21), // start 131 l_ankle (3.56 before FIRST_PAPER_SWINGS = 1; 58 l_shoulder earlier), stop 395 l_ankle; stop 2.7 before STOP_SWING2_ADVANCE
         (3.0, 1.8, true, 4.6, 2.9), // start 64 l_elbow, stop 433 l_ankle
         (3.0, 2.0, true, 4.1, 2.3), // start 66 r_knee, stop 499 l_elbow
         (5.0, 1.5, true, 5.64, 2.08), // start 51 r_ankle (6.8 at 101 l_ankle before the contact rate 6 rad/s), stop 305 l_heel; stop 4.5 before STOP_SWING2_ADVANCE

@@ -477,10 +477,11 @@ pub fn generate_steps(
     // The last pre-roll step's stance roll (its start, samples): the recorded walk's first
     // trailing leg is that leg, so its roll is smoothed across the two (see `smooth_rolls`).
     let mut pre_stance: Option<(f64, Vec<(f64, f64)>)> = None;
-    // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): the swings
-    // the start from standing and the stop were tuned on keep the paper's swing and toe off.
+    // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): the first
+    // swing from standing and the last two before a stop keep the paper's swing and toe off.
     let knee_brake = |kk: usize| {
-        !((opt.start_from_rest && kk < FIRST_PAPER_SWINGS) || (opt.stop && kk + 2 >= all.len()))
+        !((opt.start_from_rest && kk < FIRST_PAPER_SWINGS)
+            || (opt.stop && kk + LAST_PAPER_SWINGS >= all.len()))
     };
     let toe_off_rate = |kk: usize| {
         if knee_brake(kk) {
@@ -747,9 +748,9 @@ pub fn generate_steps(
             clearance: a.toe_clearance_m,
             theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
             max_step: a.max_step_s,
-            // The first two swings from standing keep the paper's swing2 (klawfirst's start).
             // The first swing from standing and the last two before a stop keep the paper's
-            // swing2 and swing3 (see `SwingSpec::knee_brake`).
+            // swing2 and swing3 (`FIRST_PAPER_SWINGS`, `LAST_PAPER_SWINGS`,
+            // `SwingSpec::knee_brake`).
             knee_brake: knee_brake(kk),
             theta3_rate_hs,
         };
@@ -1496,11 +1497,29 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
     [line - cos_h.acos(), knee]
 }
 
-/// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
-/// Returns the sagittal thigh angle (positive: knee behind the hip).
-/// Swings from standing that keep the paper's swing and toe off (the start's first two swings,
-/// klawfirst's; see `SwingSpec::knee_brake`).
-const FIRST_PAPER_SWINGS: usize = 3;
+/// Swings from standing that keep the paper's swing and toe off (see `SwingSpec::knee_brake`):
+/// the first only, whose trailing leg stood under the hip with its knee bounded by
+/// [`FIRST_TOE_OFF_THIGH`].
+///
+/// Measured (`kstart`: 6 steps from standing + stop, 1.5/1.8/2.0 m): 3 (the earlier hand-off)
+/// → 1 takes the second swing's ankle peak/mean speed at 1/2/3/5/7 km/h from 2.96/2.70/2.87,
+/// 2.84/2.90/2.81, 2.33/2.38/2.38, 1.65/1.72/1.79, 1.67/1.60/1.59 to 2.50/2.69/2.80,
+/// 2.21/2.21/2.15, 1.81/1.84/1.84, 1.31/1.43/1.52, 1.38/1.32/1.33 (the third's at 2 km/h from
+/// 3.0–3.2 to 2.0–2.3), the start region no worse anywhere (2 km/h × 1.5/2.0 m 4.42/4.97 →
+/// 4.12/4.75); 0 (the first swing braked too) left its peak/mean about the same at 1–2 km/h,
+/// worse at 3–7 km/h (3.0–3.2 → 3.2–3.4, 1.9–2.0 → 2.5–2.7) and 5 km/h × 1.5 m's start at 13.6.
+const FIRST_PAPER_SWINGS: usize = 1;
+
+/// Swings before a stop that keep the paper's swing and toe off: the stop's half step and
+/// the swing before it (see `SwingSpec::knee_brake`).
+///
+/// Measured (as [`FIRST_PAPER_SWINGS`]): 1 would take the swing before the half step from the
+/// paper's ankle peak/mean 3.0–3.2 (2 km/h) and 2.5–2.6 (3 km/h) to the steady walk's 2.0–2.3
+/// and 1.7–1.9, and the whole walk's worst ratio at 2 km/h × 1.8/2.0 m from 5.56/5.02 to
+/// 4.62/4.75, but the stop's landing knee at 1 km/h × 1.5/2.0 m from 2.3/1.9 to 4.8/2.4 (it
+/// leaves the locked swing knee at 0.5 rad/s); 0 (the half step braked too) sank its heel
+/// 0.5–1.3 mm into the ground at 3 and 5 km/h.
+const LAST_PAPER_SWINGS: usize = 2;
 
 /// The swing thigh's rate θ̇3 at heel strike for which the collision
 /// ([`collision::heel_strike`]) leaves the stance hip's forward velocity unchanged, rad/s: the
@@ -1572,6 +1591,8 @@ fn swing_span_target(
     [p.x, p.y, p.z]
 }
 
+/// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
+/// Returns the sagittal thigh angle (positive: knee behind the hip).
 fn place_leg(
     skeleton: &Skeleton,
     pose: &mut crate::generator::skeleton::Pose,
