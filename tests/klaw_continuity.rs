@@ -118,8 +118,10 @@ const BOUND_3KMH: f64 = 4.8; // measured 3.80 (frame 44, r_knee): k = 5 met
 // the heel strikes' ankle ≤ 6.1), 7 km/h 16.1 → 10.6 (frame 0 9.6), schedule 7.23 → 5.73.
 // klawhs s6 (contact ankle rate 3 → 6 rad/s): 5 km/h 6.01 → 4.74 (k = 5 met; frame 0), 7 km/h
 // 10.8 → 10.2 (frame 0; the heel strikes ≤ 8.5).
-const BOUND_5KMH: f64 = 5.9; // measured 4.74 (frame 0, l_ankle; 6.06 at frame 56, r_ankle, heel strike, before the contact rate 6; 8.53 at frame 0 before the push-off)
-const BOUND_7KMH: f64 = 12.7; // measured 10.20 (frame 0, l_ankle; 10.57–10.8 at frame 283, l_ankle, heel strike, before the contact rate 6; 16.1 at frame 0 before the push-off)
+// klawhs s6 (the midstance lock, `stance::lock_shortening`): 7 km/h 10.2 → 6.44 (frame 0; the
+// heel strikes ≤ 6.4); 5 km/h 4.74 → 4.17 (frame 445, l_hip).
+const BOUND_5KMH: f64 = 5.3; // measured 4.17 (frame 445, l_hip, since the midstance lock); 4.74 (frame 0, l_ankle; 6.06 at frame 56, r_ankle, heel strike, before the contact rate 6; 8.53 at frame 0 before the push-off)
+const BOUND_7KMH: f64 = 8.1; // measured 6.44 (frame 0, l_ankle; 10.20 before the midstance lock; 10.57–10.8 at frame 283, l_ankle, heel strike, before the contact rate 6; 16.1 at frame 0 before the push-off)
 
 // klawfirst2 (`hold_knees`: the trailing knee no longer straightens again around heel strike):
 // 6 km/h × 2.0 m 10.5 (frame 0, r_knee: the trailing knee's straightening at the walk's first
@@ -184,8 +186,8 @@ fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
 }
 
 /// Worst ankle ratio within ± 3 frames of a heel strike, measured (klawhs) × 1.25.
-const HS_ANKLE_5KMH: f64 = 1.25 * 4.61; // 6.06 before the contact rate 6 rad/s, 8.1 before the push-off
-const HS_ANKLE_7KMH: f64 = 1.25 * 8.55; // 10.57 before the contact rate 6 rad/s, 13.9 before the push-off
+const HS_ANKLE_5KMH: f64 = 1.25 * 3.94; // 4.61 before the midstance lock, 6.06 before the contact rate 6 rad/s, 8.1 before the push-off
+const HS_ANKLE_7KMH: f64 = 1.25 * 6.42; // 8.55 before the midstance lock, 10.57 before the contact rate 6 rad/s, 13.9 before the push-off
 
 /// A walk of 6 steps at `kmh` and height `h` that ends in a stop (from standing if `rest`), and
 /// its heel strikes as fractional frame numbers.
@@ -253,12 +255,12 @@ fn the_start_and_the_stop_do_not_regress() {
         (3.0, 1.5, false, 4.9, 2.21), // start 0 l_ankle (5.0 before the push-off), stop 395 l_ankle; stop 2.7 before STOP_SWING2_ADVANCE
         (3.0, 1.8, false, 3.9, 2.9), // start 44 r_knee, stop 433 l_ankle
         (3.0, 2.0, false, 3.7, 2.3), // start 47 r_knee, stop 499 l_elbow
-        (5.0, 1.5, false, 9.29, 2.08), // start 0 l_ankle (9.5 before the contact rate 6 rad/s), stop 305 l_heel; 12.1 before the rocker's landing scan; stop 4.4 before STOP_SWING2_ADVANCE
-        (5.0, 1.8, false, 4.74, 2.82), // start 0 l_ankle (4.8 before the contact rate 6 rad/s, 8.6 before the push-off), stop 334 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
-        (5.0, 2.0, false, 3.77, 3.11), // start 0 l_ankle (6.0 before the contact rate 6 rad/s; 6.86 at 0 r_knee since the push-off: the trailing knee straightens to rest at the first heel strike), stop 352 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
-        (7.0, 1.5, false, 10.3, 2.65), // start 43 r_ankle (12.3 before the contact rate 6 rad/s), stop 258 l_ankle; stop 3.5 before STOP_SWING2_ADVANCE
-        (7.0, 1.8, false, 9.7, 4.47), // start 0 l_ankle (16.1 before the push-off; 10.2 on c4af9fa and since, bound kept), stop 5.24 since the push-off, stop 282 l_heel; stop 4.7 before STOP_SWING2_ADVANCE
-        (7.0, 2.0, false, 5.83, 1.95), // start 0 l_ankle (10.1 before the push-off), stop 2.41 since the push-off, stop 299 l_ankle; stop 2.3 before STOP_SWING2_ADVANCE
+        (5.0, 1.5, false, 6.16, 2.08), // start 0 l_ankle (9.29 before the midstance lock; 9.5 before the contact rate 6 rad/s), stop 305 l_heel; 12.1 before the rocker's landing scan; stop 4.4 before STOP_SWING2_ADVANCE
+        (5.0, 1.8, false, 3.66, 2.82), // start 0 l_ankle (4.74 before the midstance lock; 4.8 before the contact rate 6 rad/s, 8.6 before the push-off), stop 334 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
+        (5.0, 2.0, false, 3.16, 3.11), // start 0 l_ankle (3.77 before the midstance lock; 6.0 before the contact rate 6 rad/s; 6.86 at 0 r_knee since the push-off: the trailing knee straightens to rest at the first heel strike), stop 352 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
+        (7.0, 1.5, false, 10.3, 2.65), // start 43 r_ankle (12.3 before the contact rate 6 rad/s; 11.2 with the midstance lock, bound kept), stop 258 l_ankle; stop 3.5 before STOP_SWING2_ADVANCE
+        (7.0, 1.8, false, 6.44, 3.99), // start 0 l_ankle (16.1 before the push-off; 10.2 on c4af9fa, before the midstance lock), stop 4.47 before the midstance lock, 5.24 since the push-off, stop 282 l_heel; stop 4.7 before STOP_SWING2_ADVANCE
+        (7.0, 2.0, false, 4.52, 1.95), // start 0 l_ankle (5.83 before the midstance lock; 10.1 before the push-off), stop 2.41 since the push-off, stop 299 l_ankle; stop 2.3 before STOP_SWING2_ADVANCE
         (1.0, 1.5, true, 5.6, 2.28), // start 113 r_heel, stop 684 l_knee; stop 2.6 before STOP_SWING2_ADVANCE
         (1.0, 1.8, true, 5.0, 3.4), // start 111 r_knee, stop 751 l_knee
         (1.0, 2.0, true, 4.1, 1.94), // start 117 r_knee, stop 793 l_knee; stop 2.1 before STOP_SWING2_ADVANCE
@@ -268,12 +270,12 @@ fn the_start_and_the_stop_do_not_regress() {
         (3.0, 1.5, true, 3.46, 2.21), // start 131 l_ankle (3.56 before FIRST_PAPER_SWINGS = 1; 58 l_shoulder earlier), stop 395 l_ankle; stop 2.7 before STOP_SWING2_ADVANCE
         (3.0, 1.8, true, 4.6, 2.9), // start 64 l_elbow, stop 433 l_ankle
         (3.0, 2.0, true, 4.1, 2.3), // start 66 r_knee, stop 499 l_elbow
-        (5.0, 1.5, true, 5.64, 2.08), // start 51 r_ankle (6.8 at 101 l_ankle before the contact rate 6 rad/s), stop 305 l_heel; stop 4.5 before STOP_SWING2_ADVANCE
-        (5.0, 1.8, true, 5.57, 2.82), // start 111 r_knee (5.6 at 31 before the contact rate 6 rad/s), stop 334 l_heel; stop 5.0 before STOP_SWING2_ADVANCE
-        (5.0, 2.0, true, 4.9, 3.11), // start 59 r_ankle (5.57 since the full first step; 5.14 at 117 r_knee with the contact rate 6 rad/s, bound kept), stop 352 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
-        (7.0, 1.5, true, 9.03, 2.65), // start 43 r_ankle (12.0 before the contact rate 6 rad/s), stop 258 l_ankle; stop 3.5 before STOP_SWING2_ADVANCE
-        (7.0, 1.8, true, 8.11, 4.47), // start 94 l_ankle (9.1 at 47 r_ankle before the contact rate 6 rad/s; 11.7 at 94 since the full first step, the second heel strike; 9.09 since the push-off), stop 5.24 since the push-off, stop 282 l_heel (5.5 with STOP_SWING1_DELAY); stop 5.1 before STOP_SWING2_ADVANCE
-        (7.0, 2.0, true, 5.15, 1.95), // start 99 l_ankle (7.6 before the contact rate 6 rad/s; 9.48 since the full first step: the second heel strike; 7.52 since the push-off), stop 2.40 since the push-off, stop 299 l_ankle; stop 2.3 before STOP_SWING2_ADVANCE
+        (5.0, 1.5, true, 5.63, 2.08), // start 51 r_ankle (6.8 at 101 l_ankle before the contact rate 6 rad/s), stop 305 l_heel; stop 4.5 before STOP_SWING2_ADVANCE
+        (5.0, 1.8, true, 4.88, 2.82), // start 31 r_knee (5.57 at 111 before the midstance lock; 5.6 at 31 before the contact rate 6 rad/s), stop 334 l_heel; stop 5.0 before STOP_SWING2_ADVANCE
+        (5.0, 2.0, true, 3.80, 3.11), // start 33 r_knee (4.9 at 59 r_ankle before; 5.57 since the full first step; 5.14 at 117 r_knee with the contact rate 6 rad/s), stop 352 l_heel; stop 4.9 before STOP_SWING2_ADVANCE
+        (7.0, 1.5, true, 9.03, 2.65), // start 43 r_ankle (12.0 before the contact rate 6 rad/s; 9.54 at 86 l_ankle with the midstance lock, bound kept), stop 258 l_ankle; stop 3.5 before STOP_SWING2_ADVANCE
+        (7.0, 1.8, true, 6.20, 3.99), // start 94 l_ankle (8.11 before the midstance lock, stop 4.47; 9.1 at 47 r_ankle before the contact rate 6 rad/s; 11.7 at 94 since the full first step, the second heel strike; 9.09 since the push-off), stop 5.24 since the push-off, stop 282 l_heel (5.5 with STOP_SWING1_DELAY); stop 5.1 before STOP_SWING2_ADVANCE
+        (7.0, 2.0, true, 4.74, 1.95), // start 50 r_ankle (5.15 at 99 l_ankle before the midstance lock; 7.6 before the contact rate 6 rad/s; 9.48 since the full first step: the second heel strike; 7.52 since the push-off), stop 2.40 since the push-off, stop 299 l_ankle; stop 2.3 before STOP_SWING2_ADVANCE
     ];
     let mut failures = Vec::new();
     for &(kmh, h, rest, start_ratio, stop_ratio) in cases {

@@ -545,6 +545,12 @@ pub fn generate_steps(
             } else {
                 super::stance::push_off_exponent(l.speed_m_per_s, body.l1)
             },
+            lock_short: 0.0,
+        };
+        // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
+        let spec = StanceSpec {
+            lock_short: super::stance::lock_shortening(spec.push_off),
+            ..spec
         };
         let (st_solved, st_run) = spec
             .solve_with(&stance_start, stance_guess, stance_jac)
@@ -655,6 +661,8 @@ pub fn generate_steps(
             .get(kk + 1)
             .map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
         stance_leg.toe_off_knee_rate = toe_off_rate(kk + 1);
+        // The knee keeps the locked leg's midstance flexion (see `StanceSpec::drawn_span`).
+        stance_leg.span_max = spec.drawn_span(&st_run, stance_leg.l3 + stance_leg.l4);
         stance_leg.toe_off_time = t_step
             + next_times
                 .map(|t| t.double_support)

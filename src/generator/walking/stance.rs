@@ -47,6 +47,17 @@
 //! the hip level but leaves the trailing knee straightening to rest within a frame of heel
 //! strike (continuity 9–24 on the trailing knee at 2.0 m), hence the moderate slope.
 //!
+//! **The midstance knee (a change to the paper's lock, issue 6).** The paper locks the rigid
+//! leg at its unloaded length `l1` — a straight knee through midstance. At speed the leg locks
+//! shorter, at `l1 (1 − δ)` ([`StanceSpec::lock_short`], [`lock_shortening`]: δ grows with the
+//! push-off exponent up to 1 %, a midstance knee flexion of ≈ 16°, the upper end of a human's at
+//! brisk speeds); the extension then lengthens the leg from there to its eq. 3 length, so the
+//! hip vaults lower and arrives at heel strike descending more slowly (measured, 1.8 m, pelvis
+//! vertical velocity before contact: 5 km/h −0.34 → −0.22 m/s, 7 km/h −0.48 → −0.30; the vault
+//! above heel strike 5.0 → 4.2 cm and 7.9 → 7.1 cm). The virtual leg draws the flexed knee
+//! ([`StanceSpec::drawn_span`]). A leg that bottoms out above the shorter length locks where
+//! it turns, as above.
+//!
 //! The paper also locks the leg when it reaches its desired length before the end of the step;
 //! here the shooting makes it reach that length exactly at the end, so that lock never engages
 //! and is not implemented.
@@ -140,6 +151,9 @@ pub struct StanceSpec {
     /// Exponent `n` of the extension's actuator profile `pa_u + P·τⁿ`, ≥ 2 (2: the extension
     /// spread over the subphase; larger: a late push-off, see [`push_off_exponent`]).
     pub push_off: f64,
+    /// How much shorter than `l1` the rigid leg locks, as a fraction of `l1` (0: the paper's
+    /// lock at `l1`; see [`lock_shortening`]).
+    pub lock_short: f64,
 }
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
@@ -161,6 +175,34 @@ pub const PUSH_OFF_MAX: f64 = 6.0;
 pub fn push_off_exponent(speed: f64, l1: f64) -> f64 {
     let froude = speed / (9.80665 * l1.max(1e-9)).sqrt();
     (2.0 + (froude - PUSH_OFF_FROUDE_0) / PUSH_OFF_FROUDE_STEP).clamp(2.0, PUSH_OFF_MAX)
+}
+
+/// Midstance shortening of the locked leg per unit of push-off exponent above 2, fraction of
+/// `l1` (see [`lock_shortening`]).
+pub const LOCK_SHORT_PER_PUSH: f64 = 0.006;
+
+/// Largest midstance shortening of the locked leg, fraction of `l1` (a knee flexion of ≈ 16°).
+pub const LOCK_SHORT_MAX: f64 = 0.01;
+
+/// How much shorter than `l1` the stance leg locks ([`StanceSpec::lock_short`]) for a stance
+/// with push-off exponent `push_off` ([`push_off_exponent`]): 0 up to the push-off's Froude
+/// speed (the paper's lock), then [`LOCK_SHORT_PER_PUSH`] per unit of exponent, at most
+/// [`LOCK_SHORT_MAX`] — 0.5 / 1.0 / 1.0 % at 4 / 5 / 7 km/h for a 1.8 m body.
+///
+/// Why (issue 6): the rigid leg at `l1` vaults the hip 5–8 cm above its heel-strike height
+/// and brings it down into the next contact at −0.34 m/s (5 km/h) to −0.48 m/s (7 km/h), 1.8 m;
+/// the landing heel's roll then starts at the hip's approach over the heel lever (≈ 20 rad/s),
+/// the landing ankle's continuity spike at 4–7 km/h. A human's stance knee stays flexed
+/// 10–20° through midstance at brisk speeds. Measured choices (8 steps, worst continuity ratio
+/// 1.5/1.8/2.0 m): 4 km/h 6.58/4.22/3.31 → 5.14/3.51/3.37, 5 km/h 9.29/4.74/3.82 →
+/// 6.16/4.17/3.34, 6 km/h 10.7/6.46/4.55 → 10.05/6.34/4.24, 7 km/h 11.0/10.2/6.15 →
+/// 11.4/6.44/5.32 (7 km/h × 1.5 m worse: its heel strikes); a cap of 0.8 % or 1.2 % moved 7 km/h × 1.5 m the same way (11.4–11.5), and
+/// 3 % landed no planned heel rocker at 5–7 km/h (the hip never came within the shorter leg of
+/// the flat ankle before the lock). Spreading the re-lengthening to `l1` over the first half of
+/// the extension instead (the knee straightening early) gave the benefit back (5 km/h × 1.5 m
+/// 9.2, 7 km/h × 1.8 m 9.9): what helps is the late extension.
+pub fn lock_shortening(push_off: f64) -> f64 {
+    (LOCK_SHORT_PER_PUSH * (push_off - 2.0)).clamp(0.0, LOCK_SHORT_MAX)
 }
 
 /// Initial state of a stance phase.
@@ -193,6 +235,34 @@ pub struct StanceRun {
 }
 
 impl StanceSpec {
+    /// The length the rigid leg locks at, m: `l1 (1 − lock_short)`.
+    pub fn lock_length(&self) -> f64 {
+        self.l1 * (1.0 - self.lock_short.max(0.0))
+    }
+
+    /// The longest hip–ankle span the virtual leg's flat and heel-off rules may draw for this
+    /// stance (`VirtualLeg::span_max`), for a straight leg spanning `leg_span`: shortened by the
+    /// lock's shortening when `run` locked at [`StanceSpec::lock_length`] (regained it from
+    /// below), so the drawn knee keeps the midstance flexion and the extension beyond that
+    /// length is drawn as the heel rising (the paper's heel-off rule, one knee angle earlier);
+    /// `leg_span` when the leg locked where it turned above that length or never locked (the
+    /// paper's straight knee: the first step at a new, faster speed, whose hip comes in high).
+    ///
+    /// Why the knee does not straighten during the extension: the late extension is fast
+    /// (≈ 0.5–1 m/s at heel strike), and a drawn knee straightening at that rate up to the
+    /// straight leg's soft limit right at the other foot's heel strike snapped to rest there
+    /// (the trailing knee, continuity 5.4–8.8 at 5 km/h × 1.8/2.0 m, measured before
+    /// `generate`'s knee hold through the double support).
+    pub fn drawn_span(&self, run: &StanceRun, leg_span: f64) -> f64 {
+        let short = self.l1 - self.lock_length();
+        match run.lock_time {
+            Some(t) if short > 0.0 && run.track.at(t).0[0] < self.lock_length() + 5e-4 => {
+                leg_span - short
+            }
+            _ => leg_span,
+        }
+    }
+
     /// Generalized forces; `f1` is the step torque's value on the current segment (`A` before
     /// `torque_off`, 0 after), fixed per integration segment rather than read from `t`: the last
     /// RK4 stage of the segment ending at `torque_off` is evaluated at `t + h`, which rounds to
@@ -293,9 +363,10 @@ impl StanceSpec {
                 qdd: [d[3], d[4], d[5]],
             }
         };
-        let l1 = self.l1;
+        // The lock's length: `l1`, shorter at speed (see `lock_short`).
+        let l1 = self.lock_length();
         // The middle level's event functions: a subphase ends when its function reaches 0.
-        // Compression ends with the lock ("leg too long": the leg is at least its unloaded length
+        // Compression ends with the lock ("leg too long": the leg is at least its lock length
         // and lengthening, `min(w − l1, ẇ) ≥ 0`) or at the vertical (`θ1 ≥ 0`). A leg that lands
         // longer than `l1` (eq. 3 asks for it at slow speeds) and bottoms out above `l1` is
         // locked where it turns (ẇ = 0) instead of lengthening telescopically: that is what the
@@ -481,6 +552,7 @@ mod tests {
             target: [0.8526964553305313, 0.23940226803375858],
             max_step: 0.004,
             push_off: 2.0,
+            lock_short: 0.0,
         };
         let start = StanceStart {
             q: [
@@ -636,6 +708,62 @@ mod tests {
         assert!(wd4 > wd2 + 0.05, "ẇ(t_step) {wd2} → {wd4}");
         assert!(vy4 > vy2 + 0.02, "hip vertical velocity {vy2} → {vy4}");
         assert_eq!(push_off_exponent(0.5, 0.87), 2.0);
+    }
+
+    #[test]
+    fn a_leg_locked_short_keeps_its_length_and_the_drawn_knee_its_flexion() {
+        assert_eq!(lock_shortening(2.0), 0.0);
+        assert!((lock_shortening(3.0) - LOCK_SHORT_PER_PUSH).abs() < 1e-15);
+        assert_eq!(lock_shortening(6.0), LOCK_SHORT_MAX);
+        let (spec, start) = grazing_spec();
+        let leg_span = spec.l1;
+        // A softer leg compresses well below l1 and regains the shorter lock length from below:
+        // it locks there, and the drawn span is shortened by as much.
+        let soft = StanceSpec {
+            k_w: 0.3 * spec.k_w,
+            lock_short: 0.005,
+            push_off: 4.0,
+            ..spec
+        };
+        // Landing with the hip closing on the ankle at 0.4 m/s.
+        let start = StanceStart {
+            qd: [-0.4, start.qd[1], 0.0],
+            ..start
+        };
+        let h = soft.step(&start);
+        let mut from_below = 0;
+        for i in 0..=10 {
+            let run = soft.run(&start, 60.0 + 4.0 * i as f64, 0.0, h, true);
+            let Some(t) = run.lock_time else { continue };
+            let w_min = run
+                .track
+                .nodes
+                .iter()
+                .filter(|n| n.t <= t)
+                .map(|n| n.q[0])
+                .fold(f64::INFINITY, f64::min);
+            if w_min < soft.lock_length() - 1e-3 {
+                from_below += 1;
+                // The drawn track is blended over the lock (≤ 0.8 mm shorter, see LOCK_BLEND).
+                let w = run.track.at(t).0[0];
+                assert!((w - soft.lock_length()).abs() < 1e-3, "locked at {w}");
+                let span = soft.drawn_span(&run, leg_span);
+                assert!((span - (leg_span - 0.005 * spec.l1)).abs() < 1e-12);
+            }
+        }
+        assert!(from_below > 0, "no lock regained from below");
+        // The grazing leg bottoms out near l1, above the shorter length: it locks where it
+        // turns and keeps the paper's straight knee.
+        let short = StanceSpec {
+            lock_short: 0.02,
+            ..spec
+        };
+        let run = short.run(&start, 76.0, 0.0, short.step(&start), true);
+        let t = run.lock_time.expect("locked");
+        assert!(run.track.at(t).0[0] > short.lock_length() + 5e-4);
+        assert_eq!(short.drawn_span(&run, leg_span), leg_span);
+        // Without the shortening, never shortened.
+        assert_eq!(spec.drawn_span(&run, leg_span), leg_span);
     }
 
     #[test]

@@ -166,6 +166,12 @@ pub struct VirtualLeg {
     /// rate at the last flat / heel-off sample, and the rule's knee then. `None` before the
     /// foot is flat.
     pub knee_ease: Option<[f64; 4]>,
+    /// Longest hip–ankle span the flat and heel-off rules draw, m: `l3 + l4` (the paper's
+    /// straight knee), shorter where the stance leg locked short of `l1` at speed
+    /// (`StanceSpec::drawn_span`): the knee then keeps that flexion through midstance and heel
+    /// off, and the heel rises as soon as the hip is farther than this from the flat ankle. The
+    /// heel rocker's landing is planned against it too (the flat foot must be within it).
+    pub span_max: f64,
 }
 
 /// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
@@ -436,6 +442,7 @@ impl VirtualLeg {
             knee_soft: KNEE_SOFT,
             slow_knee_start: true,
             knee_ease: None,
+            span_max: body.l3 + body.l4,
         }
     }
 
@@ -579,7 +586,8 @@ impl VirtualLeg {
             let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
             (hip[0] - p.ankle[0]).hypot(dy)
         };
-        let a0 = l1 - 2.0 * soft;
+        // The flat period's soft leg length (see `span_max`).
+        let a0 = self.span_max.min(l1) - 2.0 * soft;
         let t_first = samples[0].0;
         let mut duration = min_duration;
         let mut best: Option<(f64, HeelRocker, f64, f64)> = None;
@@ -765,18 +773,20 @@ impl VirtualLeg {
             // period ends — heel-off begins — when θ5 reaches its dorsiflexion limit or the foot
             // must roll, whichever comes first.
             // The knee straightens smoothly: the leg's length follows the hip–flat-ankle distance
-            // up to l1 − 2σ, then a C¹ quadratic blend saturating at l1 − σ (a knee flexion of
-            // about 5° at σ = 1.5 mm), so the knee comes to rest without a kink.
+            // up to l − 2σ, then a C¹ quadratic blend saturating at l − σ (a knee flexion of
+            // about 5° at σ = 1.5 mm for l = l1), so the knee comes to rest without a kink;
+            // l = `span_max` (l1, or the shorter locked leg at speed).
             let d_flat = {
                 let p = self.pose_at(hip, dz, 0.0);
                 reach(&p, hip) + l1
             };
             let sigma = self.knee_soft;
-            let a0 = l1 - 2.0 * sigma;
+            let lm = self.span_max.min(l1);
+            let a0 = lm - 2.0 * sigma;
             let d_t = if d_flat <= a0 {
                 d_flat
-            } else if d_flat >= l1 {
-                l1 - sigma
+            } else if d_flat >= lm {
+                lm - sigma
             } else {
                 d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
             };
@@ -900,6 +910,32 @@ mod tests {
             .map(|w| ((w[2] - 2.0 * w[1] + w[0]) / 0.002f64.powi(2)).abs())
             .fold(0.0, f64::max);
         (peak, end)
+    }
+
+    #[test]
+    fn a_shorter_span_keeps_the_knee_flexed_and_raises_the_heel() {
+        let body = Body::from_height(1.8, 75.0).unwrap();
+        let mut leg = test_leg(&body, FootPeriod::Flat, 0.0);
+        let full = leg.l3 + leg.l4;
+        leg.span_max = full - 0.012;
+        let sigma = leg.knee_soft;
+        let [x, y] = leg.flat_ankle;
+        // Within the shorter span: the foot flat, the knee spanning the hip–ankle distance.
+        // The hip behind the ankle (the shank about vertical, θ5 below its limit).
+        let back = 0.15;
+        let hip = |d: f64| [x - back, y + (d * d - back * back).sqrt()];
+        let d = leg.span_max - 3.0 * sigma;
+        let p = leg.advance(0.0, hip(d), 0.0);
+        assert_eq!(p.period, FootPeriod::Flat);
+        assert!(p.rho == 0.0 && (p.knee - knee_for(leg.l3, leg.l4, d)).abs() < 1e-9);
+        // Beyond it (still within the straight leg's reach): the knee keeps the shorter span's
+        // flexion and the heel rises instead.
+        let p = leg.advance(0.01, hip(leg.span_max + 0.005), 0.0);
+        assert_eq!(p.period, FootPeriod::HeelOff);
+        assert!(p.rho > 0.0);
+        let k = knee_for(leg.l3, leg.l4, leg.span_max - sigma);
+        assert!((p.knee - k).abs() < 1e-6, "knee {} against {k}", p.knee);
+        assert!(k > 0.2, "{k}");
     }
 
     #[test]
