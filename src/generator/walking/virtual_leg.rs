@@ -482,13 +482,21 @@ impl VirtualLeg {
     /// that flexed); `from` itself when it already is.
     pub fn roll_for_knee(&self, hip: [f64; 2], dz: f64, from: f64, knee: f64) -> f64 {
         let d_target = span_for(self.l3, self.l4, knee);
-        let g = |r: f64| {
-            let p = self.pose_at(hip, dz, r);
-            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-            (hip[0] - p.ankle[0]).hypot(dy) - d_target
-        };
+        let g = |r: f64| self.span_at(hip, dz, r) - d_target;
         let cap = (self.theta6_max + RHO_CAP).max(from);
         self.smallest(from, cap, g)
+    }
+
+    /// The hip–ankle distance (in the leg's plane, lateral offset `dz` included) at roll `rho`,
+    /// m: the only part of [`VirtualLeg::pose_at`] the roll scans test. Why: those scans
+    /// evaluate dozens of rolls per frame, and the full pose (two acos, two atan2, a sin/cos)
+    /// was most of the walk's kinematics; this is the same arithmetic on the same rolled ankle,
+    /// so the scans' answers are bit-identical.
+    #[inline]
+    fn span_at(&self, hip: [f64; 2], dz: f64, rho: f64) -> f64 {
+        let (ankle, _, _) = self.foot.rolled(self.flat_ankle, rho, self.theta6_max);
+        let dy = ((hip[1] - ankle[1]).powi(2) + dz * dz).sqrt();
+        (hip[0] - ankle[0]).hypot(dy)
     }
 
     /// Finds the first `ρ ≥ lo` (continuing from `lo`, the previous roll) with `g(ρ) ≤ 0`: a
@@ -581,11 +589,7 @@ impl VirtualLeg {
         let (l3, l4) = (self.l3, self.l4);
         let l1 = l3 + l4;
         let pitch = -self.rho;
-        let dist = |rho: f64, hip: [f64; 2], dz: f64| {
-            let p = self.pose_at(hip, dz, rho);
-            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-            (hip[0] - p.ankle[0]).hypot(dy)
-        };
+        let dist = |rho: f64, hip: [f64; 2], dz: f64| self.span_at(hip, dz, rho);
         // The flat period's soft leg length (see `span_max`).
         let a0 = self.span_max.min(l1) - 2.0 * soft;
         let t_first = samples[0].0;
@@ -732,10 +736,8 @@ impl VirtualLeg {
     /// and returns the configuration. Calls must come in time order.
     pub fn advance(&mut self, t: f64, hip: [f64; 2], dz: f64) -> LegPose {
         let l1 = self.l3 + self.l4;
-        let reach = |p: &LegPose, hip: [f64; 2]| {
-            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-            (hip[0] - p.ankle[0]).hypot(dy) - l1
-        };
+        // How far `leg`'s ankle at roll `r` is beyond the straight leg's reach, m.
+        let reach = |leg: &VirtualLeg, r: f64| leg.span_at(hip, dz, r) - l1;
         if self.period == FootPeriod::HeelRocker {
             if let Some((end, rho)) = self.rocker.as_ref().map(|r| (r.end, r.rho_at(t))) {
                 if t < end {
@@ -749,7 +751,7 @@ impl VirtualLeg {
         }
         if self.period == FootPeriod::HeelRocker {
             // Largest ρ ≤ 0 within reach of the straight leg: reach(ρ) increases with ρ here.
-            let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip);
+            let g = |r: f64| reach(self, r);
             if g(0.0) <= 0.0 {
                 self.period = FootPeriod::Flat;
                 self.rho = 0.0;
@@ -776,10 +778,7 @@ impl VirtualLeg {
             // up to l − 2σ, then a C¹ quadratic blend saturating at l − σ (a knee flexion of
             // about 5° at σ = 1.5 mm for l = l1), so the knee comes to rest without a kink;
             // l = `span_max` (l1, or the shorter locked leg at speed).
-            let d_flat = {
-                let p = self.pose_at(hip, dz, 0.0);
-                reach(&p, hip) + l1
-            };
+            let d_flat = reach(self, 0.0) + l1;
             let sigma = self.knee_soft;
             let lm = self.span_max.min(l1);
             let a0 = lm - 2.0 * sigma;
@@ -796,7 +795,9 @@ impl VirtualLeg {
             } else {
                 d_t
             };
-            let g = |r: f64| reach(&self.pose_at(hip, dz, r), hip) + l1 - d_t;
+            // `reach(r) + l1`, not the span itself: the same rounding as before the scans
+            // stopped evaluating the whole pose.
+            let g = |r: f64| reach(self, r) + l1 - d_t;
             let lo = self.rho.max(0.0);
             let rho = self.smallest(lo, cap, g);
             if self.period == FootPeriod::Flat
@@ -843,11 +844,7 @@ impl VirtualLeg {
         let knee = knee_ms + (self.knee_toe_off - knee_ms) * s;
         let (l3, l4) = (self.l3, self.l4);
         let d_target = (l3 * l3 + l4 * l4 + 2.0 * l3 * l4 * knee.cos()).sqrt();
-        let g = |r: f64| {
-            let p = self.pose_at(hip, dz, r);
-            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-            (hip[0] - p.ankle[0]).hypot(dy) - d_target
-        };
+        let g = |r: f64| self.span_at(hip, dz, r) - d_target;
         let rho = self.smallest(self.rho, cap.max(self.rho), g);
         self.rho = rho;
         let mut p = self.pose_at(hip, dz, rho);
