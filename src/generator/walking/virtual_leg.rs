@@ -380,8 +380,15 @@ fn solve_pinned(a: &[[f64; 3]], target: &[f64], pinned: &[Option<f64>]) -> Vec<f
 /// `g ≤ 0` side: the Illinois variant of regula falsi (superlinear, a handful of evaluations of
 /// the leg's geometry instead of bisection's thirty-odd), bisecting whenever it stalls.
 fn root_nonpositive_side(g: &impl Fn(f64) -> f64, pos: f64, neg: f64) -> f64 {
-    let (mut a, mut ga) = (pos, g(pos));
-    let (mut b, mut gb) = (neg, g(neg));
+    root_from(g, (pos, g(pos)), (neg, g(neg)))
+}
+
+/// [`root_nonpositive_side`] from two points whose values of `g` are already known (`ga > 0`,
+/// `gb ≤ 0`): a scan has just evaluated them, and `g` is a pure function, so the answer is the
+/// same without evaluating them twice.
+fn root_from(g: &impl Fn(f64) -> f64, (pos, gpos): (f64, f64), (neg, gneg): (f64, f64)) -> f64 {
+    let (mut a, mut ga) = (pos, gpos);
+    let (mut b, mut gb) = (neg, gneg);
     let mut side = 0i8;
     for _ in 0..100 {
         if (b - a).abs() < 1e-10 || gb == 0.0 {
@@ -503,23 +510,25 @@ impl VirtualLeg {
     /// scan in small increments, then bisection inside the increment — `g` need not be monotone,
     /// and the roll never jumps to a distant root.
     fn smallest(&self, lo: f64, hi: f64, g: impl Fn(f64) -> f64) -> f64 {
-        if g(lo) <= 0.0 {
+        let mut gb = g(lo);
+        if gb <= 0.0 {
             return lo;
         }
         let step = 0.004;
-        let mut a;
+        let (mut a, mut ga);
         let mut b = lo;
         loop {
             if b >= hi {
                 return hi;
             }
-            a = b;
+            (a, ga) = (b, gb);
             b = (b + step).min(hi);
-            if g(b) <= 0.0 {
+            gb = g(b);
+            if gb <= 0.0 {
                 break;
             }
         }
-        root_nonpositive_side(&g, a, b)
+        root_from(&g, (a, ga), (b, gb))
     }
 
     /// Plans the heel rocker from the hip's path `samples` (`(t, hip, dz)` in time order, the
