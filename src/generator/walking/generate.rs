@@ -284,6 +284,30 @@ fn num_err(stage: String, message: String) -> GenerateError {
     GenerateError::Numerical { stage, message }
 }
 
+/// Froude speed `v/√(g·l1)` from which the stance leg locks at the sagittal projection of the
+/// drawn 3-D leg (`StanceSpec::lock_reach`; ≈ 2.6 km/h at 1.8 m).
+///
+/// Why not below: at 1–2 km/h the planned heel rocker lands the knee nearly straight and the
+/// eased knee (`virtual_leg::KNEE_EASE`) rolls the foot from foot flat on; with the lower hip
+/// the landing knee jumped (measured, 8 steps: 1 km/h × 2.0 m 4.65 → 111 at foot flat, 2 km/h ×
+/// 1.5 m 4.0 → 10.6 at heel strike), so those walks keep the paper's lock.
+pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.24;
+
+/// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m).
+///
+/// Why not above: at 7 km/h × 1.5/1.8 m (Froude 0.73 / 0.67) the heel strikes improved but the
+/// walk's first and last frames got worse (measured, 8 steps: 11.4 → 20.6 at frame 2, the
+/// trailing toe; 6.44 → 9.48 at the last frame, the shoulder), beyond their guards.
+pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
+
+/// Whether a stance at `speed` m/s of a body with unloaded leg `l1` locks at the sagittal
+/// projection of the drawn leg (see [`PROJECTED_LOCK_FROUDE_MIN`]): not on the first step from
+/// standing nor the last before a stop (`edge`), whose own rules keep their measured landings.
+fn projected_lock(speed: f64, l1: f64, edge: bool) -> bool {
+    let froude = speed / (9.80665 * l1.max(1e-9)).sqrt();
+    !edge && (PROJECTED_LOCK_FROUDE_MIN..PROJECTED_LOCK_FROUDE_MAX).contains(&froude)
+}
+
 fn side_z(side: Side, a: &WalkAttributes) -> f64 {
     match side {
         Side::Left => -0.5 * a.stride_width_m,
@@ -546,10 +570,30 @@ pub fn generate_steps(
                 super::stance::push_off_exponent(l.speed_m_per_s, body.l1)
             },
             lock_short: 0.0,
+            lock_reach: 0.0,
         };
         // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
+        let lock_short = super::stance::lock_shortening(spec.push_off);
+        // The rigid leg is the sagittal projection of the drawn 3-D leg, whose hip is `dz` beside
+        // the stance foot, with the virtual leg's soft knee (flat only up to 2·KNEE_SOFT short of
+        // straight): the stance heel stays down through midstance (`StanceSpec::lock_length`).
+        // The largest `dz` of the stance (sampled; its peak is at midstance, in the lock).
+        let zf_lock = side_z(stance_side, a);
+        let dz_max = (0..=32)
+            .map(|i| {
+                let t = t_step * i as f64 / 32.0;
+                (det.lateral_at(t) - det.swing_offset(t).z - zf_lock).abs()
+            })
+            .fold(0.0, f64::max);
+        let lock_full = body.l1 * (1.0 - lock_short);
+        let lock_flat = lock_full - 2.0 * KNEE_SOFT - STAND_MARGIN;
         let spec = StanceSpec {
-            lock_short: super::stance::lock_shortening(spec.push_off),
+            lock_short,
+            lock_reach: if projected_lock(l.speed_m_per_s, body.l1, from_rest || to_rest) {
+                lock_full - (lock_flat * lock_flat - dz_max * dz_max).max(0.0).sqrt()
+            } else {
+                0.0
+            },
             ..spec
         };
         let (st_solved, st_run) = spec

@@ -154,6 +154,10 @@ pub struct StanceSpec {
     /// How much shorter than `l1` the rigid leg locks, as a fraction of `l1` (0: the paper's
     /// lock at `l1`; see [`lock_shortening`]).
     pub lock_short: f64,
+    /// How much shorter still the rigid (sagittal) leg locks so that the drawn 3-D leg reaches
+    /// its flat foot with the virtual leg's soft knee, m (0: none; see
+    /// [`StanceSpec::lock_length`]).
+    pub lock_reach: f64,
 }
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
@@ -235,9 +239,19 @@ pub struct StanceRun {
 }
 
 impl StanceSpec {
-    /// The length the rigid leg locks at, m: `l1 (1 − lock_short)`.
+    /// The length the rigid leg locks at, m: `l1 (1 − lock_short) − lock_reach`.
+    ///
+    /// A change to the paper's model (issue 6): the stance model is sagittal, the drawn leg is
+    /// not — its hip sits `dz` ≈ 4–6 cm beside the foot (pelvis width, stride width, lateral
+    /// displacement) — so a sagittal leg locked at the straight leg's length put the 3-D
+    /// hip–ankle distance ≈ `dz²/2l` ≈ 2 mm beyond it, and with the virtual leg's soft knee
+    /// (flat only up to `l − 2σ`) the flat foot rolled onto its ball: the heel hovered ≈ 5 mm
+    /// up from foot flat to heel off. The rigid leg here is the sagittal projection of the 3-D
+    /// leg with that soft knee (`lock_reach`, set by the generator from the stance's largest
+    /// `dz`, at Froude speeds 0.24–0.65: `generate::PROJECTED_LOCK_FROUDE_MIN`), so the stance
+    /// heel stays down until the extension lifts it.
     pub fn lock_length(&self) -> f64 {
-        self.l1 * (1.0 - self.lock_short.max(0.0))
+        self.l1 * (1.0 - self.lock_short.max(0.0)) - self.lock_reach.max(0.0)
     }
 
     /// The longest hip–ankle span the virtual leg's flat and heel-off rules may draw for this
@@ -245,8 +259,15 @@ impl StanceSpec {
     /// lock's shortening when `run` locked at [`StanceSpec::lock_length`] (regained it from
     /// below), so the drawn knee keeps the midstance flexion and the extension beyond that
     /// length is drawn as the heel rising (the paper's heel-off rule, one knee angle earlier);
-    /// `leg_span` when the leg locked where it turned above that length or never locked (the
-    /// paper's straight knee: the first step at a new, faster speed, whose hip comes in high).
+    /// longer by as much as the leg locked above that length where it turned, up to `leg_span`
+    /// (the paper's straight knee: the first step at a new, faster speed, whose hip comes in
+    /// high); `leg_span` when it never locked or `lock_short` is 0. `lock_reach` does not
+    /// shorten it: it is the drawn leg's lateral geometry, not a knee flexion to keep.
+    ///
+    /// Why the turned lock keeps its knee: with `lock_reach` more legs lock where they turn
+    /// just above the lock length; drawn with the straight leg's span their knee straightened
+    /// through the extension and stopped at the other foot's heel strike (5 km/h × 1.8 m,
+    /// continuity 4.17 → 6.52; 3.63 with this rule).
     ///
     /// Why the knee does not straighten during the extension: the late extension is fast
     /// (≈ 0.5–1 m/s at heel strike), and a drawn knee straightening at that rate up to the
@@ -254,10 +275,14 @@ impl StanceSpec {
     /// (the trailing knee, continuity 5.4–8.8 at 5 km/h × 1.8/2.0 m, measured before
     /// `generate`'s knee hold through the double support).
     pub fn drawn_span(&self, run: &StanceRun, leg_span: f64) -> f64 {
-        let short = self.l1 - self.lock_length();
+        // Only the midstance knee's shortening: `lock_reach` is the drawn leg's own geometry.
+        // A leg that locked where it turned above the lock length keeps the knee it turned
+        // with (the span grows by as much, up to the straight leg).
+        let short = self.l1 * self.lock_short.max(0.0);
         match run.lock_time {
-            Some(t) if short > 0.0 && run.track.at(t).0[0] < self.lock_length() + 5e-4 => {
-                leg_span - short
+            Some(t) if short > 0.0 => {
+                let above = (run.track.at(t).0[0] - self.lock_length()).max(0.0);
+                (leg_span - short + above).min(leg_span)
             }
             _ => leg_span,
         }
@@ -553,6 +578,7 @@ mod tests {
             max_step: 0.004,
             push_off: 2.0,
             lock_short: 0.0,
+            lock_reach: 0.0,
         };
         let start = StanceStart {
             q: [
@@ -748,20 +774,32 @@ mod tests {
                 let w = run.track.at(t).0[0];
                 assert!((w - soft.lock_length()).abs() < 1e-3, "locked at {w}");
                 let span = soft.drawn_span(&run, leg_span);
-                assert!((span - (leg_span - 0.005 * spec.l1)).abs() < 1e-12);
+                let above = (w - soft.lock_length()).max(0.0);
+                assert!((span - (leg_span - 0.005 * spec.l1 + above)).abs() < 1e-12);
+                assert!(span <= leg_span - 0.005 * spec.l1 + 1e-3);
+                // The lateral reach shortens the lock, not the drawn span.
+                let reach = StanceSpec {
+                    lock_reach: 0.004,
+                    ..soft
+                };
+                assert!((reach.lock_length() - (soft.lock_length() - 0.004)).abs() < 1e-15);
             }
         }
         assert!(from_below > 0, "no lock regained from below");
         // The grazing leg bottoms out near l1, above the shorter length: it locks where it
-        // turns and keeps the paper's straight knee.
+        // turns and keeps the knee it turned with (the span longer by as much, ≤ leg_span).
         let short = StanceSpec {
             lock_short: 0.02,
             ..spec
         };
         let run = short.run(&start, 76.0, 0.0, short.step(&start), true);
         let t = run.lock_time.expect("locked");
-        assert!(run.track.at(t).0[0] > short.lock_length() + 5e-4);
-        assert_eq!(short.drawn_span(&run, leg_span), leg_span);
+        let w = run.track.at(t).0[0];
+        assert!(w > short.lock_length() + 5e-4);
+        let span = short.drawn_span(&run, leg_span);
+        let expected = (leg_span - 0.02 * spec.l1 + (w - short.lock_length())).min(leg_span);
+        assert!((span - expected).abs() < 1e-12, "{span} vs {expected}");
+        assert!(span > leg_span - 0.02 * spec.l1 + 5e-4);
         // Without the shortening, never shortened.
         assert_eq!(spec.drawn_span(&run, leg_span), leg_span);
     }
