@@ -304,7 +304,7 @@ pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
 /// projection of the drawn leg (see [`PROJECTED_LOCK_FROUDE_MIN`]): not on the first step from
 /// standing nor the last before a stop (`edge`), whose own rules keep their measured landings.
 fn projected_lock(speed: f64, l1: f64, edge: bool) -> bool {
-    let froude = speed / (9.80665 * l1.max(1e-9)).sqrt();
+    let froude = super::stance::froude_speed(speed, l1);
     !edge && (PROJECTED_LOCK_FROUDE_MIN..PROJECTED_LOCK_FROUDE_MAX).contains(&froude)
 }
 

@@ -170,6 +170,13 @@ pub const PUSH_OFF_FROUDE_STEP: f64 = 0.119;
 /// Largest push-off exponent (not reached below ≈ 7.5 km/h at 1.5 m).
 pub const PUSH_OFF_MAX: f64 = 6.0;
 
+/// Froude speed `v/√(g·l1)` of a walk at `speed` m/s with an unloaded leg `l1` m long: the
+/// dimensionless speed at which bodies of different heights walk alike (the push-off and the
+/// projected lock are set on it).
+pub fn froude_speed(speed: f64, l1: f64) -> f64 {
+    speed / (crate::units::G * l1.max(1e-9)).sqrt()
+}
+
 /// The extension profile's exponent `n` (see [`StanceSpec::push_off`]) for a walk at `speed`
 /// m/s with an unloaded leg `l1` m long: 2 up to the Froude speed [`PUSH_OFF_FROUDE_0`], then
 /// growing by one per [`PUSH_OFF_FROUDE_STEP`], capped at [`PUSH_OFF_MAX`] — 2 / 2.8 / 3.6 / 4.4
@@ -177,7 +184,7 @@ pub const PUSH_OFF_MAX: f64 = 6.0;
 /// with walking speed; the Froude speed makes bodies of different heights push alike at
 /// dynamically similar speeds.
 pub fn push_off_exponent(speed: f64, l1: f64) -> f64 {
-    let froude = speed / (9.80665 * l1.max(1e-9)).sqrt();
+    let froude = froude_speed(speed, l1);
     (2.0 + (froude - PUSH_OFF_FROUDE_0) / PUSH_OFF_FROUDE_STEP).clamp(2.0, PUSH_OFF_MAX)
 }
 
