@@ -86,6 +86,9 @@ pub struct StepReport {
     pub errors: [f64; 5],
     /// Rounds of the swing2 ground-stubbing recovery.
     pub recovery_rounds: usize,
+    /// Final set-point shift of swing2's ground-stubbing recovery (§4.3), rad: 0 when the foot
+    /// cleared the ground without it, at most [`super::swing::RECOVERY_MAX_RAD`].
+    pub recovery_rad: f64,
     /// Lowest swing-foot clearance, m.
     pub min_clearance_m: f64,
     /// When the stance leg was locked / passed the vertical, s from the step's start.
@@ -864,6 +867,7 @@ pub fn generate_steps(
                     sw.end_errors[2],
                 ],
                 recovery_rounds: sw.recovery_rounds,
+                recovery_rad: sw.recovery,
                 min_clearance_m: sw.min_clearance,
                 lock_s: st_run.lock_time,
             });
