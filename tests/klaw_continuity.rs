@@ -25,13 +25,7 @@ use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, Wal
 fn worst(sched: &[(f64, usize)], h: f64, rest_and_stop: bool) -> (f64, String) {
     let schedule: Vec<ScheduleEntry> = sched
         .iter()
-        .map(|&(kmh, steps)| ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps,
-        })
+        .map(|&(kmh, steps)| ScheduleEntry::at_speed(kmh / 3.6, steps))
         .collect();
     let opts = WalkOptions {
         height_m: h,
@@ -156,13 +150,7 @@ fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
 fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
     let rate = gaitfit::generator::walking::generate::MAX_CONTACT_ANKLE_RATE;
     for (kmh, bound) in [(5.0, HS_ANKLE_5KMH), (7.0, HS_ANKLE_7KMH)] {
-        let schedule = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(kmh / 3.6),
-                ..Default::default()
-            },
-            steps: 8,
-        }];
+        let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
         let (m, _) = generate_walk(&schedule, &WalkOptions::default()).unwrap();
         let fps = m.fps();
         let mut seen = (f64::INFINITY, 0.0f64);
@@ -202,13 +190,7 @@ fn six_steps_to_a_stop(kmh: f64, h: f64, rest: bool) -> (Motion, Vec<f64>) {
         stop: true,
         ..Default::default()
     };
-    let schedule = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps: 6,
-    }];
+    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 6)];
     let (m, _) = generate_walk(&schedule, &opts).unwrap();
     let hs = m
         .events
@@ -329,13 +311,7 @@ fn the_trailing_knee_does_not_straighten_in_double_support() {
                 height_m: h,
                 ..Default::default()
             };
-            let schedule = [ScheduleEntry {
-                params: WalkParams {
-                    speed_m_per_s: Some(kmh / 3.6),
-                    ..Default::default()
-                },
-                steps: 8,
-            }];
+            let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
             let (m, _) = generate_walk(&schedule, &opts).unwrap();
             let fps = m.fps();
             let mut worst = (0.0f64, 0usize);

@@ -21,9 +21,7 @@
 use gaitfit::events::{steps_from_trial, EventOptions, Gait, PrimarySource};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::walking::high_level::phase_times;
-use gaitfit::generator::walking::{
-    generate_walk, ScheduleEntry, WalkOptions, WalkParams, WalkReport,
-};
+use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkReport};
 use gaitfit::ingest::trials::StepRow;
 
 /// A steady walk of `steps` steps at `kmh` and height `h`, with its options and report.
@@ -32,13 +30,7 @@ fn steady_walk(kmh: f64, h: f64, steps: usize) -> (WalkOptions, Motion, WalkRepo
         height_m: h,
         ..Default::default()
     };
-    let sched = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps,
-    }];
+    let sched = [ScheduleEntry::at_speed(kmh / 3.6, steps)];
     let (m, r) = generate_walk(&sched, &opts).unwrap();
     (opts, m, r)
 }

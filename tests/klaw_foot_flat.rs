@@ -8,20 +8,14 @@
 //! midstance is where the drawn hip joint passes over the drawn ankle.
 use gaitfit::events::{EventKind, Side};
 use gaitfit::generator::skeleton::Landmark;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
+use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 
 /// For every steady stance (foot flat followed by heel off on the same side) of an 8-step
 /// steady walk at `kmh`, `h` m: the highest the stance heel gets from foot flat to the later of
 /// heel off and midstance (m), the lowest heel-off frame minus its midstance frame, and the
 /// number of stances checked.
 fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize) {
-    let schedule = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps: 8,
-    }];
+    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
     let opts = WalkOptions {
         height_m: h,
         ..Default::default()

@@ -23,13 +23,7 @@ fn walk(
         height_m: h,
         ..Default::default()
     };
-    let sched = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps,
-    }];
+    let sched = [ScheduleEntry::at_speed(kmh / 3.6, steps)];
     let (m, r) = generate_walk(&sched, &opts).unwrap();
     (m, r, opts)
 }

@@ -8,18 +8,12 @@
 //! landmarks (the pelvis as the mid-point of the hip joints, which cancels the pelvic list).
 use gaitfit::events::{EventKind, Side};
 use gaitfit::generator::skeleton::Landmark;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
+use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 
 /// (most negative pelvis vertical velocity, fastest hip approach to the landing heel) over the
 /// contacts of a steady 8-step walk, m/s, and the number of contacts.
 fn approach(kmh: f64, h: f64) -> (f64, f64, usize) {
-    let schedule = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps: 8,
-    }];
+    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
     let opts = WalkOptions {
         height_m: h,
         ..Default::default()
@@ -96,13 +90,7 @@ fn slow_walks_keep_the_quadratic_extension() {
 /// negative pelvis vertical velocity over the last frame before a contact (m/s), over a steady
 /// 8-step walk at `kmh`, 1.8 m.
 fn midstance_knee_and_descent(kmh: f64) -> (f64, f64) {
-    let schedule = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(kmh / 3.6),
-            ..Default::default()
-        },
-        steps: 8,
-    }];
+    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
     let (m, _) = generate_walk(&schedule, &WalkOptions::default()).unwrap();
     let fps = m.fps();
     let frame = |t: f64| (t * fps).round() as usize;

@@ -66,6 +66,20 @@ pub struct ScheduleEntry {
     pub steps: usize,
 }
 
+impl ScheduleEntry {
+    /// `steps` steps at `speed_m_per_s` (m/s), the step length and frequency completed by the
+    /// normalizing formula (eq. 1) — the natural walk at that speed.
+    pub fn at_speed(speed_m_per_s: f64, steps: usize) -> ScheduleEntry {
+        ScheduleEntry {
+            params: WalkParams {
+                speed_m_per_s: Some(speed_m_per_s),
+                ..Default::default()
+            },
+            steps,
+        }
+    }
+}
+
 /// Number of steps of a walk of `seconds` with parameters `params` (at least one).
 pub fn steps_for_duration(
     params: &WalkParams,

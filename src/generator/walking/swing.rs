@@ -828,7 +828,7 @@ impl SwingSpec<'_> {
         let mut fail_hi: Option<(usize, f64)> = None;
         let mut clear_lo = None;
         let mut best_fail = None;
-        let (s2, lowest, rounds) = loop {
+        let (s2, _, rounds) = loop {
             let pa = k as f64 * RECOVERY_STEP;
             let x0 = match slope {
                 Some(d) if self.knee_brake => {
@@ -855,12 +855,7 @@ impl SwingSpec<'_> {
                     60,
                 )
                 .map_err(|e| format!("swing2: {e}"))?;
-                Solved {
-                    x: [s.x[0], 0.0],
-                    residual: [s.residual[0], 0.0],
-                    iterations: s.iterations,
-                    jacobian: None,
-                }
+                padded(s)
             } else {
                 // The Jacobian is carried from grid point to grid point and from step to step
                 // (Broyden-updated): a fresh finite-difference one cost two simulations per
@@ -935,9 +930,7 @@ impl SwingSpec<'_> {
             k = next.min(cap).min(RECOVERY_MAX).max(k + 1);
         };
         let pa = rounds as f64 * RECOVERY_STEP;
-        let before = track.nodes.len();
         let (y2, _) = self.swing2(y2_0, s2.x, pa, h, Some(&mut track));
-        let _ = before;
         // Knee lock at t2: the knee's impulse leaves the thigh's generalized momentum unchanged.
         let m = self.model.mass_matrix(&[y2[0], y2[1]]);
         let th3d =
@@ -971,12 +964,7 @@ impl SwingSpec<'_> {
                 60,
             )
             .map_err(|e| format!("swing3: {e}"))?;
-            Solved {
-                x: [s.x[0], 0.0],
-                residual: [s.residual[0], 0.0],
-                iterations: s.iterations,
-                jacobian: None,
-            }
+            padded(s)
         };
         let y3 = self.swing3(y3_0, s3.x, h, Some(&mut track));
         // Clearance over the swing from 30 % of swing1 on (the toe is leaving before that).
@@ -987,7 +975,6 @@ impl SwingSpec<'_> {
             .filter(|n| n.t >= t_check && n.t <= t2)
             .map(|n| self.foot_points(n.t, &n.q).lowest())
             .fold(f64::INFINITY, f64::min);
-        let _ = lowest;
         Ok(SwingRun {
             iterations: [it1, it2, s3.iterations],
             params: [a1, s2.x[0], s3.x[0], extra, pa, s2.x[1], s3.x[1]],
@@ -1049,6 +1036,17 @@ impl Hasher for TimeHasher {
     fn write_u64(&mut self, x: u64) {
         let h = (x ^ self.0).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         self.0 = h ^ (h >> 29);
+    }
+}
+
+/// A one-unknown solve in the two-unknown form of the braked swing (the second unknown, the
+/// brake or landing-rate ramp, fixed at 0).
+fn padded(s: Solved<1>) -> Solved<2> {
+    Solved {
+        x: [s.x[0], 0.0],
+        residual: [s.residual[0], 0.0],
+        iterations: s.iterations,
+        jacobian: None,
     }
 }
 
