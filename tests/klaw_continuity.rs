@@ -86,6 +86,9 @@ fn continuity_ratios_do_not_regress() {
         (&[(5.0, 8)], 1.8, false, BOUND_5KMH),
         (&[(7.0, 8)], 1.8, false, BOUND_7KMH),
         (&[(2.0, 4), (5.0, 4), (3.0, 4)], 1.8, true, BOUND_SCHEDULE),
+        // Meets k = 5 since the speed-up's push-off (`generate::speeds_up`): 4.75 (frame 92,
+        // r_heel, the start); 5.07 at 381 (r_knee, the trailing knee of the first 5 km/h step).
+        (&[(2.0, 4), (5.0, 4), (3.0, 4)], 2.0, true, 5.0),
     ];
     let mut failures = Vec::new();
     for &(sched, h, rest, bound) in cases {
@@ -125,7 +128,7 @@ const BOUND_7KMH: f64 = 8.1; // measured 6.44 (frame 0, l_ankle; 10.20 before th
 // 4.55 with klawhs' contact rate 6 rad/s: asserted in `continuity_is_met_at_1_to_7_kmh`.
 // klawflat (the stance leg locks at the projection of the drawn 3-D leg): 7 km/h × 2.0 m
 // 5.32 → 4.61 (frame 348, r_ankle): asserted there; 6 km/h × 2.0 m 4.24 → 3.60.
-const BOUND_SCHEDULE: f64 = 7.2; // measured 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
+const BOUND_SCHEDULE: f64 = 7.2; // measured 6.08 (frame 851, l_knee, the stop's last swing, since the speed-up's push-off, `generate::speeds_up`; 6.20 at 362, r_knee, the trailing knee of the first 5 km/h step, before); 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
 
 /// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
 fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
@@ -348,6 +351,59 @@ fn the_trailing_knee_does_not_straighten_in_double_support() {
                 failures.push(format!(
                     "{kmh} km/h {h} m: {:.5} at frame {}",
                     worst.0, worst.1
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A speed-up's trailing leg pushes off (`generate::speeds_up`): in the double support of the
+/// first faster step of 2 → 4 and 2 → 5 km/h (4 steps each, from standing, with a stop,
+/// 1.5/1.8/2.0 m) the trailing knee never straightens by more than 1 mrad in a frame (the
+/// continuity floor) and leaves the ground flexed ≥ 0.4 rad. Before, that leg left the ground
+/// nearly straight (0.12 rad at 2 → 5 km/h × 1.8 m, heel 7 cm up) after a flexion of 0.016 rad
+/// that straightened again at up to 6.9 mrad/frame just before toe off (continuity 6.2 there;
+/// 12.2 at 2 → 4 km/h × 2.0 m).
+#[test]
+fn a_speed_up_pushes_off_with_the_trailing_knee() {
+    let mut failures = Vec::new();
+    for fast in [4.0, 5.0] {
+        for h in [1.5, 1.8, 2.0] {
+            let opts = WalkOptions {
+                height_m: h,
+                start_from_rest: true,
+                stop: true,
+                ..Default::default()
+            };
+            let schedule = [
+                ScheduleEntry::at_speed(2.0 / 3.6, 4),
+                ScheduleEntry::at_speed(fast / 3.6, 4),
+            ];
+            let (m, report) = generate_walk(&schedule, &opts).unwrap();
+            let step = &report.steps[4];
+            let knee = joint_angles(
+                &m,
+                match step.stance_side.opposite() {
+                    gaitfit::events::Side::Left => Joint::LKnee,
+                    gaitfit::events::Side::Right => Joint::RKnee,
+                },
+            );
+            let fps = m.fps();
+            let a = (step.start_s * fps).floor() as usize;
+            let b = ((step.start_s + step.times.double_support) * fps).floor() as usize;
+            let straighten = (a..b)
+                .map(|f| knee[f] - knee[f + 1])
+                .fold(f64::NEG_INFINITY, f64::max);
+            println!(
+                "2 -> {fast} km/h {h} m: trailing knee straightens at most {straighten:.5} \
+                 rad/frame in frames {a}..{b}, {:.3} rad at toe off",
+                knee[b]
+            );
+            if straighten > 1e-3 || knee[b] < 0.4 {
+                failures.push(format!(
+                    "2 -> {fast} km/h {h} m: straightens {straighten:.5}, toe-off knee {:.3}",
+                    knee[b]
                 ));
             }
         }

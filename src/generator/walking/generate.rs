@@ -655,7 +655,11 @@ pub fn generate_steps(
         // frame). The first step's trailing leg stands under the hip, where a flexed knee pitches
         // the thigh forward: its knee flexes only as far as keeps the thigh at toe off behind
         // `FIRST_TOE_OFF_THIGH` of its heel-strike angle (see there).
-        if opt.start_from_rest && kk < 2 && trailing.period != FootPeriod::MetaOff {
+        // So does a trailing leg whose stance was slower than the step it toes off in (a speed
+        // change in the schedule, `speeds_up`): see there.
+        if ((opt.start_from_rest && kk < 2) || speeds_up(&all, kk))
+            && trailing.period != FootPeriod::MetaOff
+        {
             let (hp, hz) = swing_hip3(0.0);
             let knee = trailing.pose_at(hp, hz - zf_w, trailing.rho).knee;
             trailing.period = FootPeriod::MetaOff;
@@ -962,6 +966,34 @@ pub fn generate_steps(
     let total = t_global + closing.as_ref().map_or(0.0, |c| c.duration);
     let motion = assemble(&skeleton, &body, &foot, &data, opt, total, closing.as_ref())?;
     Ok((motion, report))
+}
+
+/// Whether step `kk` of `all` is faster than the step before it: its trailing leg, whose heel-off
+/// rule ran at the slower step's hip, enters meta-off at the start of the double support (if
+/// it is not there yet), as the first trailing legs from standing do.
+///
+/// Why: a slow stance leaves the trailing leg in heel off, knee straight, at the slower walk's
+/// roll; the faster step's double support is short and its hip fast, so the heel-off rule
+/// reached no meta-off before toe off. The leg left the ground with its knee straight (2 km/h
+/// stance, 5 km/h toe off × 1.8 m: 0.118 rad, heel 7 cm up), and the least-bending roll
+/// ([`smooth_roll`]), which rounded the rule's accelerating roll, drew a knee that flexed by
+/// 0.016 rad and straightened again at 0.7 rad/frame in the last frames before toe off, which
+/// [`hold_knees`] cannot hold there (the toe-off samples are the swing's start): continuity 6.2
+/// on that knee (2 → 5 → 3 km/h, 1.8 m; 5.07 at 2.0 m, 12.2 on 2 → 4 km/h × 2.0 m). A person
+/// speeding up pushes off with that leg: its knee now flexes from rest (the meta-off blend) to
+/// its toe-off value. Measured (from standing with a stop, 1.5/1.8/2.0 m; the worst ratio of the
+/// whole walk, before → after): 2 → 5 → 3 km/h 5.56/6.20/5.07 → 5.56/6.08/4.75 (the trailing
+/// knee gone; 1.8 m's worst is now the stop); 2 → 4 km/h 4.97/6.22/12.2 → 4.97/5.24/5.87;
+/// 1 → 7 km/h × 2.0 m 8.74 → 5.36; 1 → 2, 1 → 3, 2 → 3 and the speed-ups from 3 km/h
+/// unchanged; **1 → 5 km/h worse, 5.53/5.69/4.58 → 6.24/6.63/4.75**: the 1 km/h leg stands
+/// nearly straight (knee 0.02–0.06 rad) and closer under the hip, and flexing it fully in the
+/// 0.10–0.15 s double support rolls the foot fast enough that the ankle's rate at toe off
+/// (the swing foot's θ5 starts at rest) spikes. Starting the blend later (only as early as a
+/// u² ramp at `TOE_OFF_KNEE_RATE` needs) was the same or worse (1 → 2 km/h × 2.0 m
+/// 4.58 → 4.73). Slower steps are left alone: 5 → 3 km/h's trailing leg enters meta-off within
+/// 5 ms of the same time either way.
+fn speeds_up(all: &[Locomotion], kk: usize) -> bool {
+    kk > 0 && all[kk].speed_m_per_s > all[kk - 1].speed_m_per_s + 1e-9
 }
 
 /// Time scale of the stance roll's smoothing after foot flat, s (see [`smooth_roll`]), for a
