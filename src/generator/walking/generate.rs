@@ -39,7 +39,12 @@ pub struct WalkOptions {
     /// Output frame rate, frames/s.
     pub fps: f64,
     /// Start from standing, feet side by side: the first step starts from rest (its swing foot
-    /// travels one step length, half a stride).
+    /// travels one step length, half a stride), and frame 0 is that first step's start.
+    /// Otherwise the walk starts steady, as a motion-capture trial of steady walking does:
+    /// [`PRE_ROLL`] unrecorded steps are simulated before it, and the recording begins
+    /// mid-motion [`LEAD_IN_FRAMES`] frames before the first heel strike (frame 0 at t = 0,
+    /// the first heel strike at `LEAD_IN_FRAMES / fps`, events and [`StepReport::start_s`] on
+    /// the same clock), in the last pre-roll step's landing swing.
     pub start_from_rest: bool,
     /// End standing: a last half step, then the trailing foot is brought alongside and the body
     /// comes to rest ([`super::stop`]).
@@ -68,7 +73,9 @@ pub struct StepReport {
     pub index: usize,
     /// The stance leg.
     pub stance_side: Side,
-    /// Start time (heel strike of the stance leg), s.
+    /// Start time (heel strike of the stance leg), s from frame 0 (the motion's clock: a
+    /// steady walk's first step starts at `LEAD_IN_FRAMES / fps`, see
+    /// [`WalkOptions::start_from_rest`]).
     pub start_s: f64,
     /// Commanded step length, m.
     pub step_length_m: f64,
@@ -393,7 +400,39 @@ const STOP_SWING2_ADVANCE: f64 = 0.08;
 const STAND_MARGIN: f64 = 1e-4;
 
 /// Unrecorded steps simulated before a steady (not from rest) start.
-pub const PRE_ROLL: usize = 1;
+///
+/// 2 (was 1; klawlead, issue 6): the recording now begins [`LEAD_IN_FRAMES`] before the first
+/// heel strike, so it draws the last pre-roll step's swing. With one pre-roll step that swing
+/// left a trailing foot that had no history (the first simulated step's, placed, not walked),
+/// and the first recorded heel strike's ankle spike was 0.4–0.8 above the walk's later heel
+/// strikes at the same sub-frame phase (8 steps, 5 km/h × 1.5 m, 6 km/h × 1.5 m, 7 km/h ×
+/// 1.8 m, phases 0–0.8 of a frame); with two it is within ±0.1 of them. Costs one simulated
+/// step per steady walk.
+pub const PRE_ROLL: usize = 2;
+
+/// Frames a steady (not from rest) walk's recording begins before its first heel strike: frame
+/// 0 is at t = 0, the first heel strike at t = `LEAD_IN_FRAMES / fps` (a whole number of frames,
+/// so every later frame samples the walk at the same phase as with no lead-in), drawn from the
+/// last pre-roll step ([`PRE_ROLL`]) — its swing leg's swing3 (knee locked, landing), its
+/// stance leg's heel-off roll. A clip of steady walking thus starts mid-motion, as a
+/// motion-capture trial does, and its first heel strike is judged like every other.
+///
+/// Why 5 (50 ms at 100 frames/s), measured with `checks::continuity` (8 steps, 1–7 km/h ×
+/// 1.5/1.8/2.0 m, 100 frames/s): a frame 0 has no earlier frames, so the check's window there
+/// is one-sided, and whatever comes to rest or turns within the first 3 frames fails it; only
+/// a stretch of the gait where nothing does can start a clip. The first heel strike needs 4
+/// frames before it (the landing heel comes to rest at the contact; with 3, frame 2's heel
+/// measured 4.2–32.8 against a window of rest); with 4, 6 km/h × 2.0 m's trailing knee
+/// measured 3.70 at frame 1 (3.50 elsewhere); 5 and 6 gave the same table; 10 put frame 0 in
+/// late swing2, where the swing knee brakes into its lock (2–5 km/h: knee 6.4–52 at frames
+/// 0–2); half the swing (whole frames) left 3 km/h × 1.8 m's shoulder turning at frame 0
+/// (4.33, 3.30 elsewhere). The shortest clean lead-in is taken: at 100 frames/s it lies within
+/// swing3 (56–111 ms on the natural walks at 1–7 km/h, knee locked) and adds 50 ms to the
+/// recording. It is a number of frames, not a time: 5 frames were as clean at 120 and
+/// 250 frames/s; at 60 frames/s they reach back into swing2's knee brake (frame 0's knee
+/// 6.6–107 at 3–7 km/h; the same walks' later heel strikes already measure 5–11 there, so the
+/// check is not met at 60 frames/s with or without a lead-in).
+pub const LEAD_IN_FRAMES: usize = 5;
 
 /// Generates a walk of the given steps (complete locomotion parameters, one per step).
 pub fn generate_steps(
@@ -433,9 +472,9 @@ pub fn generate_steps(
     };
     // A steady start is preceded by PRE_ROLL unrecorded copies of the first step: the steady
     // state is only approximated for the first of them (eq. 3 and the speed), and its trailing
-    // foot has no history, so it may toe off late and abruptly. One simulated step brings the
+    // foot has no history, so it may toe off late and abruptly. The simulated steps bring the
     // hip's velocities, the forces and the trailing foot's roll onto the periodic walk (the
-    // shooting then carries them on), so the recorded walk starts steady.
+    // shooting then carries them on), so the recorded walk, lead-in included, starts steady.
     let pre = if opt.start_from_rest { 0 } else { PRE_ROLL };
     let mut stance_side = if pre % 2 == 0 {
         Side::Left
@@ -493,17 +532,21 @@ pub fn generate_steps(
     let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
         .chain(steps.iter().copied())
         .collect();
+    // Time origin: frame 0 at t = 0, the first recorded heel strike at t = LEAD_IN_FRAMES / fps
+    // (at 0 from rest), the pre-roll steps before it.
+    let lead = if pre > 0 {
+        LEAD_IN_FRAMES as f64 / opt.fps
+    } else {
+        0.0
+    };
     let mut t_global =
-        -(pre as f64) * phase_times(steps[0].step_freq_steps_per_min, &opt.relations).step;
+        lead - pre as f64 * phase_times(steps[0].step_freq_steps_per_min, &opt.relations).step;
     let mut prev_hs_pitch = if from_rest {
         0.0
     } else {
         heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch
     };
     let n = all.len();
-    // The last pre-roll step's stance roll (its start, samples): the recorded walk's first
-    // trailing leg is that leg, so its roll is smoothed across the two (see `smooth_rolls`).
-    let mut pre_stance: Option<(f64, Vec<(f64, f64)>)> = None;
     // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): the first
     // swing from standing and the last two before a stop keep the paper's swing and toe off.
     let knee_brake = |kk: usize| {
@@ -727,17 +770,6 @@ pub fn generate_steps(
                 (t, hp, hz - zf_s)
             })
             .collect();
-        // The recorded walk's first frame is exactly at this heel strike, where the straight leg
-        // falls up to ≈ 1 mm short of the landing pitch's ankle (eq. 3's sagittal geometry
-        // against the 3-D leg, whose hip is ≈ 4 cm beside the foot): that frame drew the heel
-        // 0.9–1.3 mm in the air and the next on the ground, a heel step after none (continuity
-        // 9.4–13.1 at frame 0 of every steady walk). The first stance foot lands pitched just
-        // enough more for the leg to reach (≈ 0.01 rad; the frame has no predecessor, and the
-        // planned rocker takes the extra pitch out over its whole duration). Later heel strikes
-        // fall between frames, where the approaching hip has already closed the gap.
-        if recorded && k == 0 && !opt.start_from_rest {
-            stance_leg.rho = reachable_landing_roll(&stance_leg, hips[0].1, hips[0].2);
-        }
         stance_leg.plan_heel_rocker(&hips, a.heel_rocker_fraction * t_step);
         let mut stance_rho = Vec::with_capacity(n_s + 1);
         let mut theta5_early = Vec::new();
@@ -749,11 +781,12 @@ pub fn generate_steps(
             }
         }
         // The previous step's swing foot lands into this heel rocker: its ankle ends swing3 with
-        // the rocker's early ankle rate (C¹ θ5 across heel strike, see `SwingFoot::theta56`).
+        // the rocker's early ankle rate (C¹ θ5 across heel strike, see `SwingFoot::theta56`);
+        // the last pre-roll step's too, which the lead-in draws.
         if let (Some(prev), Some(&a), Some(&b)) =
             (data.last_mut(), theta5_early.first(), theta5_early.last())
         {
-            if kk > pre && b.0 > a.0 {
+            if b.0 > a.0 {
                 prev.swing_foot.theta5_rate_hs = ((b.1 - a.1) / (b.0 - a.0))
                     .clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
             }
@@ -875,29 +908,29 @@ pub fn generate_steps(
                 min_clearance_m: sw.min_clearance,
                 lock_s: st_run.lock_time,
             });
-            data.push(StepData {
-                side: stance_side,
-                start: t_global,
-                loc: *l,
-                times,
-                ankle_x: ax,
-                det,
-                stance: st_run,
-                swing: sw,
-                swing_foot: sspec.swing_foot(),
-                knee_brake: sspec.knee_brake,
-                swing_times,
-                stance_rho,
-                stance_hips: hips.iter().map(|&(_, hp, dz)| (hp, dz)).collect(),
-                stance_leg: stance_leg.clone(),
-                trail_rho,
-                trail_hips,
-                trail_leg,
-                trail_origin: t_global - trailing_clock,
-            });
-        } else {
-            pre_stance = Some((t_global, stance_rho));
         }
+        // The pre-roll step too: the lead-in draws its last frames, and its stance leg is the
+        // recorded walk's first trailing leg (rolls smoothed across both, `smooth_rolls`).
+        data.push(StepData {
+            side: stance_side,
+            start: t_global,
+            loc: *l,
+            times,
+            ankle_x: ax,
+            det,
+            stance: st_run,
+            swing: sw,
+            swing_foot: sspec.swing_foot(),
+            knee_brake: sspec.knee_brake,
+            swing_times,
+            stance_rho,
+            stance_hips: hips.iter().map(|&(_, hp, dz)| (hp, dz)).collect(),
+            stance_leg: stance_leg.clone(),
+            trail_rho,
+            trail_hips,
+            trail_leg,
+            trail_origin: t_global - trailing_clock,
+        });
         // Next step.
         ankle_x[idx(swing_side)] = new_ankle_x;
         trailing = stance_leg;
@@ -908,7 +941,7 @@ pub fn generate_steps(
         t_global += t_step;
         from_rest = false;
     }
-    smooth_rolls(&mut data, pre_stance);
+    smooth_rolls(&mut data);
     hold_knees(&mut data);
     // The stop: the trailing foot is brought alongside and the body comes to rest.
     let closing = match (opt.stop, data.last()) {
@@ -1012,9 +1045,7 @@ const ROLL_TAU: f64 = 0.02;
 /// 1 km/h from 11.7 (rule) to 9.9, 10 ms to 7.9 but left 3 km/h's heel off at 5.1; the scaled
 /// time scale gives 6.5 (not at heel off) and 3 km/h below 4.
 ///
-/// `pre`: the stance roll of the unrecorded pre-roll step before a steady start (its start,
-/// samples), whose leg is the first step's trailing leg.
-fn smooth_rolls(data: &mut [StepData], pre: Option<(f64, Vec<(f64, f64)>)>) {
+fn smooth_rolls(data: &mut [StepData]) {
     let smooth = |times: &[f64], rho: &mut Vec<f64>, knee_soft: f64| {
         let from = rho.iter().position(|&r| r >= 0.0).unwrap_or(rho.len());
         // Landing flat from the heel rocker: at rest.
@@ -1022,38 +1053,18 @@ fn smooth_rolls(data: &mut [StepData], pre: Option<(f64, Vec<(f64, f64)>)>) {
         let tau = ROLL_TAU * (knee_soft / KNEE_SOFT).clamp(0.0, 1.0).sqrt();
         smooth_roll(times, rho, from, rest, tau);
     };
-    // The first step's trailing leg. After a pre-roll its stance began in the pre-roll step,
-    // so it is joined with the pre-roll's stance and smoothed as every later step's (smoothed
-    // alone over the recorded double support, its start was a free end: with the forward-mean
-    // smoother that was the 7 km/h × 1.5 m toe-bend jump at frame 2, ratio 25.5). From rest its
-    // stance begins with the walk.
+    // The first step's trailing leg: from rest its stance begins with the walk; after a steady
+    // start the first step is the unrecorded pre-roll (whose trailing leg has no history and is
+    // never drawn), and the recorded walk's first trailing leg is the pre-roll's stance leg,
+    // joined with it below as every later step's (smoothed alone over the recorded double
+    // support, its start was a free end: with the forward-mean smoother that was the
+    // 7 km/h × 1.5 m toe-bend jump at frame 2, ratio 25.5).
     if let Some(d) = data.first_mut() {
-        let (mut times, mut rho) = match &pre {
-            Some((start, samples)) => (
-                samples.iter().map(|s| start + s.0).collect::<Vec<f64>>(),
-                samples.iter().map(|s| s.1).collect::<Vec<f64>>(),
-            ),
-            None => (Vec::new(), Vec::new()),
-        };
-        let n0 = times.len();
-        let mut skipped = 0;
-        for &(t, r) in &d.trail_rho {
-            let g = d.start + t;
-            if times.last().is_some_and(|&l| g <= l + 1e-12) {
-                skipped += 1;
-                continue;
-            }
-            times.push(g);
-            rho.push(r);
-        }
+        let times: Vec<f64> = d.trail_rho.iter().map(|s| d.start + s.0).collect();
+        let mut rho: Vec<f64> = d.trail_rho.iter().map(|s| s.1).collect();
         smooth(&times, &mut rho, d.trail_leg.knee_soft);
-        let last = rho[n0.saturating_sub(1).min(rho.len().saturating_sub(1))];
-        for (i, s) in d.trail_rho.iter_mut().enumerate() {
-            s.1 = if i < skipped {
-                last
-            } else {
-                rho[n0 + i - skipped]
-            };
+        for (s, r) in d.trail_rho.iter_mut().zip(rho) {
+            s.1 = r;
         }
     }
     for k in 0..data.len() {
@@ -1287,11 +1298,21 @@ fn assemble(
     motion.reserve(frames);
     let swing_model = super::dynamics::SwingModel::new(body);
     let mut arms = ArmLag::new(opt.fps);
-    for i in 0..frames {
+    // A steady walk's lead-in starts mid-motion: the arms' lag is run over the pre-roll's last
+    // frames before frame 0 (5 time constants, the lag's start forgotten to < 1 %), so frame 0's
+    // arms already trail their thighs as they do mid-walk instead of starting on them.
+    let warm = data.first().map_or(0, |d| {
+        ((-d.start).max(0.0) * opt.fps)
+            .floor()
+            .min((5.0 * ARM_LAG * opt.fps).ceil()) as i64
+    });
+    for i in -warm..frames as i64 {
         let t = (i as f64 / opt.fps).min(total);
         if let Some(c) = closing.filter(|c| t > c.start) {
             let (pose, contact) = closing_pose(skeleton, foot, c, t, a, &mut arms);
-            motion.push_frame(pose, contact);
+            if i >= 0 {
+                motion.push_frame(pose, contact);
+            }
             continue;
         }
         let k = data.partition_point(|d| d.start <= t).saturating_sub(1);
@@ -1390,7 +1411,9 @@ fn assemble(
             Side::Left => 0,
             Side::Right => 1,
         }] = contact_w;
-        motion.push_frame(pose, contact);
+        if i >= 0 {
+            motion.push_frame(pose, contact);
+        }
     }
     // Events.
     let mut events = Vec::new();
@@ -1458,6 +1481,9 @@ fn assemble(
         events.push(ev(c.start + c.landing, tr, EventKind::HeelStrike));
         events.push(ev(c.start + c.landing, tr, EventKind::FootFlat));
     }
+    // A steady walk's pre-roll step is drawn only over the lead-in: its events before frame 0
+    // (its heel strike, its trailing leg's toe off) are not in the recording.
+    events.retain(|e| e.time_s >= -1e-9);
     events.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
     events.dedup_by(|x, y| {
         x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9
@@ -1752,31 +1778,6 @@ fn first_toe_off_knee(
     lo
 }
 
-/// The heel-rocker roll at which the straight leg `leg` reaches its ankle from the hip at `hip`
-/// (lateral offset `dz`) with the heel on the ground: `leg.rho` if it already does, else the
-/// nearest more pitched roll that does (bisection down to −1.2 rad, 60 halvings).
-fn reachable_landing_roll(leg: &VirtualLeg, hip: [f64; 2], dz: f64) -> f64 {
-    let l1 = leg.l3 + leg.l4;
-    let reach = |r: f64| {
-        let p = leg.pose_at(hip, dz, r);
-        let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-        (hip[0] - p.ankle[0]).hypot(dy) - l1
-    };
-    let (mut lo, mut hi) = (-1.2, leg.rho.min(0.0));
-    if reach(hi) <= 0.0 || reach(lo) > 0.0 {
-        return leg.rho;
-    }
-    for _ in 0..60 {
-        let m = 0.5 * (lo + hi);
-        if reach(m) > 0.0 {
-            hi = m;
-        } else {
-            lo = m;
-        }
-    }
-    lo
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1840,41 +1841,5 @@ mod tests {
             assert!(d.swing_hip_offset(0.0)[0] < 0.0 && d.swing_hip_offset(0.56)[0] > 0.0);
             assert!(d.swing_hip_offset(0.28)[1] < 0.0 && d.swing_hip_offset(0.0)[1].abs() < 1e-12);
         }
-    }
-
-    #[test]
-    fn landing_roll_puts_the_straight_leg_in_reach_with_the_heel_down() {
-        let body = Body::from_height(1.8, 75.0).unwrap();
-        let foot = FootShape::new(&body);
-        let leg = super::super::virtual_leg::test_leg(&body, FootPeriod::HeelRocker, -0.3);
-        let l1 = body.l3 + body.l4;
-        let dist = |r: f64, hip: [f64; 2], dz: f64| {
-            let p = leg.pose_at(hip, dz, r);
-            let dy = ((hip[1] - p.ankle[1]).powi(2) + dz * dz).sqrt();
-            (hip[0] - p.ankle[0]).hypot(dy)
-        };
-        // A hip 1 mm beyond the straight leg's reach of the landing pitch's ankle, 4 cm aside.
-        let dz = 0.04;
-        let (ankle, _, _) = foot.rolled(leg.flat_ankle, leg.rho, leg.theta6_max);
-        let a = 20f64.to_radians();
-        let r = ((l1 + 0.001).powi(2) - dz * dz).sqrt();
-        let hip = [ankle[0] - r * a.sin(), ankle[1] + r * a.cos()];
-        assert!(dist(leg.rho, hip, dz) > l1 + 0.0009);
-        let rho = reachable_landing_roll(&leg, hip, dz);
-        // More pitched, by about 1 mm over the heel-to-ankle lever, and just within reach.
-        assert!(rho < leg.rho && rho > leg.rho - 0.05, "{rho}");
-        let d = dist(rho, hip, dz);
-        assert!(d <= l1 && d > l1 - 1e-9, "{}", d - l1);
-        // The heel stays where it landed.
-        let heel = |r: f64| {
-            foot.points(foot.rolled(leg.flat_ankle, r, leg.theta6_max).0, -r, 0.0)
-                .heel
-        };
-        assert!((heel(rho)[0] - heel(leg.rho)[0]).abs() < 1e-12);
-        assert!((heel(rho)[1] - heel(leg.rho)[1]).abs() < 1e-12);
-        // Already in reach: unchanged.
-        let near = [hip[0] + 0.01, hip[1] - 0.01];
-        assert!(dist(leg.rho, near, dz) < l1);
-        assert_eq!(reachable_landing_roll(&leg, near, dz), leg.rho);
     }
 }
