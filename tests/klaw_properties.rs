@@ -221,3 +221,52 @@ fn grid_of_walks_meets_their_constraints() {
         failures.len()
     );
 }
+
+#[test]
+#[ignore = "slow (286 walks with a stop, ≈ 5 s in release); CI runs it with --ignored"]
+fn walks_with_a_stop_never_saturate_the_recovery() {
+    // The stop's swings (8 steps, from standing and steady, 1–7 km/h every 0.5 km/h ×
+    // 1.5–2.0 m every 5 cm) never run out of swing2's stubbing recovery and never sink into the
+    // ground. Before the swings before a stop were braked (`generate::FIRST_PAPER_SWINGS`' doc),
+    // the half step saturated it at 3–4 km/h × 1.5–1.55 m (0.8 rad, clearing the toe clearance
+    // by one grid step); measured now at most 0.64 rad (3.5 km/h × 1.5 m).
+    let mut failures = Vec::new();
+    let mut most = (0.0f64, String::new());
+    for i in 0..=12 {
+        for j in 0..=10 {
+            let (kmh, h) = (1.0 + 0.5 * f64::from(i), 1.5 + 0.05 * f64::from(j));
+            for rest in [true, false] {
+                let opts = WalkOptions {
+                    height_m: h,
+                    start_from_rest: rest,
+                    stop: true,
+                    ..Default::default()
+                };
+                let sched = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
+                let (m, r) = generate_walk(&sched, &opts).unwrap();
+                let ctx = format!("{kmh:.1} km/h, h = {h:.2} m, from standing {rest}");
+                for s in &r.steps {
+                    if s.recovery_rad > most.0 {
+                        most = (s.recovery_rad, format!("{ctx}, step {}", s.index));
+                    }
+                    if s.recovery_rad >= RECOVERY_MAX_RAD - 1e-9 {
+                        failures.push(format!(
+                            "{ctx}: swing2 recovery saturated at {} rad in step {}",
+                            s.recovery_rad, s.index
+                        ));
+                    }
+                }
+                let pen = ground_penetration(&m, 0.001);
+                if !pen.passed {
+                    failures.push(format!("{ctx}: {pen}"));
+                }
+            }
+        }
+    }
+    println!("largest recovery {:.2} rad ({})", most.0, most.1);
+    assert!(
+        failures.is_empty(),
+        "{} of 286 walks: {failures:#?}",
+        failures.len()
+    );
+}

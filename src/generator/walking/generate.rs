@@ -381,20 +381,6 @@ const STOP_SWING1_DELAY: f64 = 0.05;
 /// 5–7 km/h unchanged).
 const STOP_LIFT: f64 = 0.5;
 
-/// How much earlier (fraction of the swing) swing2 ends in the last step before a stop: its
-/// knee locks straight earlier and swing3 carries the straight leg to the heel strike.
-///
-/// With the default end (85 %) the half step's knee still extended at 10 rad/s into its lock
-/// one frame before it (2 km/h × 1.8 m: knee 0.075 → 0.102 → 0 rad/frame), jolting the thigh and,
-/// through the arm swing, the opposite shoulder and elbow (ratio 6.6). Measured, not derived
-/// (worst ratio over that half step, steady start + stop, 1.5/1.8/2.0 m, with `STOP_LIFT`):
-/// 85 % 1 km/h 4.5/5.5/3.3, 2 km/h 4.6/6.6/6.4, 3 km/h 4.6/4.8/5.6; 77 % 4.5/3.6/4.6,
-/// 4.3/4.5/5.0, 4.6/3.6/6.6 (3 km/h × 2.0 m worse, its knee at the lock); the closing after it
-/// 5 km/h 4.4/4.9/4.9 → 2.1/2.8/3.1 and 7 km/h × 1.8 m 5.2 → 4.5. 80 % left 7 km/h × 1.8 m's
-/// stop at 8.4, 78.5 % 1–3 km/h within 5.3 but 7 km/h × 1.5 m's half step 5.2 → 6.3; 75 % and
-/// 82 % were worse.
-const STOP_SWING2_ADVANCE: f64 = 0.08;
-
 /// How much shorter than the soft knee's straight limit the standing legs are, m (floating-point
 /// margin, so that the standing feet are flat, not rolled by 1e-12).
 const STAND_MARGIN: f64 = 1e-4;
@@ -547,12 +533,10 @@ pub fn generate_steps(
         heel_strike(&body, steps[0].step_length_m, theta5_hs, ahead)?.foot_pitch
     };
     let n = all.len();
-    // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): the first
-    // swing from standing and the last two before a stop keep the paper's swing and toe off.
-    let knee_brake = |kk: usize| {
-        !((opt.start_from_rest && kk < FIRST_PAPER_SWINGS)
-            || (opt.stop && kk + LAST_PAPER_SWINGS >= all.len()))
-    };
+    // The knee brake and the brisk toe off go together (see `SwingSpec::knee_brake`): only the
+    // first swing from standing keeps the paper's swing and toe off (the swings before a stop
+    // are braked too, see `FIRST_PAPER_SWINGS`).
+    let knee_brake = |kk: usize| !(opt.start_from_rest && kk < FIRST_PAPER_SWINGS);
     let toe_off_rate = |kk: usize| {
         if knee_brake(kk) {
             TOE_OFF_KNEE_RATE
@@ -799,13 +783,7 @@ pub fn generate_steps(
         } else {
             a.swing1_end
         };
-        let swing2_end = if to_rest {
-            (a.swing2_end - STOP_SWING2_ADVANCE)
-                .max(swing1_end + 0.5 * (a.swing2_end - a.swing1_end))
-        } else {
-            a.swing2_end
-        };
-        let swing_times = [t0, t0 + swing1_end * tsw, t0 + swing2_end * tsw, t_step];
+        let swing_times = [t0, t0 + swing1_end * tsw, t0 + a.swing2_end * tsw, t_step];
         let breakpoints = st_run.track.breakpoints();
         let hip_fn = &swing_hip;
         let theta3_rate_hs = neutral_landing_rate(
@@ -840,9 +818,8 @@ pub fn generate_steps(
             clearance: a.toe_clearance_m,
             theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
             max_step: a.max_step_s,
-            // The first swing from standing and the last two before a stop keep the paper's
-            // swing2 and swing3 (`FIRST_PAPER_SWINGS`, `LAST_PAPER_SWINGS`,
-            // `SwingSpec::knee_brake`).
+            // The first swing from standing keeps the paper's swing2 and swing3
+            // (`FIRST_PAPER_SWINGS`, `SwingSpec::knee_brake`); the swings before a stop are braked.
             knee_brake: knee_brake(kk),
             theta3_rate_hs,
         };
@@ -1622,18 +1599,29 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
 /// 3.0–3.2 to 2.0–2.3), the start region no worse anywhere (2 km/h × 1.5/2.0 m 4.42/4.97 →
 /// 4.12/4.75); 0 (the first swing braked too) left its peak/mean about the same at 1–2 km/h,
 /// worse at 3–7 km/h (3.0–3.2 → 3.2–3.4, 1.9–2.0 → 2.5–2.7) and 5 km/h × 1.5 m's start at 13.6.
-const FIRST_PAPER_SWINGS: usize = 1;
-
-/// Swings before a stop that keep the paper's swing and toe off: the stop's half step and
-/// the swing before it (see `SwingSpec::knee_brake`).
 ///
-/// Measured (as [`FIRST_PAPER_SWINGS`]): 1 would take the swing before the half step from the
-/// paper's ankle peak/mean 3.0–3.2 (2 km/h) and 2.5–2.6 (3 km/h) to the steady walk's 2.0–2.3
-/// and 1.7–1.9, and the whole walk's worst ratio at 2 km/h × 1.8/2.0 m from 5.56/5.02 to
-/// 4.62/4.75, but the stop's landing knee at 1 km/h × 1.5/2.0 m from 2.3/1.9 to 4.8/2.4 (it
-/// leaves the locked swing knee at 0.5 rad/s); 0 (the half step braked too) sank its heel
-/// 0.5–1.3 mm into the ground at 3 and 5 km/h.
-const LAST_PAPER_SWINGS: usize = 2;
+/// The swings before a stop are braked like every steady swing (`SwingSpec::knee_brake`, the
+/// brisk toe off): the stop's half step and the swing before it used to keep the paper's swing
+/// (`LAST_PAPER_SWINGS` = 2), and the half step's swing2 ended at 77 % of the swing instead of
+/// 85 % (`STOP_SWING2_ADVANCE` = 0.08) so that its unbraked knee, extending at 10–15 rad/s,
+/// locked earlier. Ending swing2 earlier extended the knee while the foot was still low: that
+/// swing needed the whole stubbing recovery ([`super::swing::RECOVERY_MAX_RAD`], 0.8 rad) at
+/// 3–4 km/h × 1.5–1.55 m and cleared the 5 mm toe clearance by one grid step. Braked, the knee
+/// comes to rest at the lock by itself, so swing2 keeps its 85 %.
+///
+/// Measured (`krec`, 8 steps from standing or steady with a stop, 1–7 km/h every 0.5 ×
+/// 1.5–2.0 m every 5 cm): the half step's recovery at most 0.80 → 0.64 rad (3.5 km/h × 1.5 m),
+/// no ground penetration, no sliding. Continuity (6 steps + stop, steady start, 1.5/1.8/2.0 m):
+/// the last half step 1–3 km/h 4.0–6.6 → 2.7–4.6 (3 km/h × 2.0 m 6.62 → 2.92); the whole walk
+/// no worse anywhere, better at 1–6 km/h (2 km/h × 1.8 m 5.56 → 4.57, 3 km/h × 2.0 m
+/// 6.62 → 3.81, 4 km/h × 2.0 m 5.98 → 3.23); the schedule 2 → 5 → 3 km/h × 1.8 m 6.08 → 4.71.
+/// The closing region alone got worse at 1 km/h × 1.5/2.0 m (2.3/1.94 → 4.78/2.44: the landing
+/// knee leaves its lock at 0.5 rad/s, then slows, against a knee at rest before it), 5 km/h ×
+/// 1.5/1.8 m (2.1/2.8 → 3.1/3.5) and 7 km/h × 1.5 m (2.6 → 3.4), all within k = 5. Braking
+/// only the swing before the half step (the half step on the paper's swing, 77 %) left the
+/// recovery at 0.80 rad; the half step braked with swing2 at 81 % needed 0.80 (and cleared
+/// only 3.5 mm), at 83 % 0.74.
+const FIRST_PAPER_SWINGS: usize = 1;
 
 /// The swing thigh's rate θ̇3 at heel strike for which the collision
 /// ([`collision::heel_strike`]) leaves the stance hip's forward velocity unchanged, rad/s: the

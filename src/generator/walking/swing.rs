@@ -327,9 +327,9 @@ const RECOVERY_MAX: usize = 40;
 /// Largest set-point shift of swing2's ground-stubbing recovery, rad (`RECOVERY_MAX` grid
 /// steps of 0.02 rad). A walk whose recovery reaches it has run out of actuator: the foot may
 /// then scuff. No steady walk of 1–7 km/h × 1.5–2.0 m reaches it (property-tested; at most
-/// 0.42 rad); the last swing before a stop needs all of it at 3–4 km/h × 1.5–1.55 m (measured
-/// 2026-11-27 at 3 km/h × 1.5 m: 4.84 mm of clearance at 0.78 rad, 5.13 mm at 0.8 rad — one grid
-/// step from scuffing; a known open item).
+/// 0.42 rad), nor does a walk with a stop (property-tested; the stop's half step needs the
+/// most, at most 0.64 rad at 3.5 km/h × 1.5 m since the swings before a stop are braked; it
+/// needed all of it at 3–4 km/h × 1.5–1.55 m before, one grid step from scuffing).
 pub const RECOVERY_MAX_RAD: f64 = RECOVERY_MAX as f64 * RECOVERY_STEP;
 
 /// Power `n` of the swing2 knee brake's shape `E·uⁿ` (`u` the fraction of swing2): the brake
