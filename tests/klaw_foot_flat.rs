@@ -12,9 +12,11 @@ use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 
 /// For every steady stance (foot flat followed by heel off on the same side) of an 8-step
 /// steady walk at `kmh`, `h` m: the highest the stance heel gets from foot flat to the later of
-/// heel off and midstance (m), the lowest heel-off frame minus its midstance frame, and the
-/// number of stances checked.
-fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize) {
+/// heel off and midstance (m), the lowest heel-off frame minus its midstance frame, the
+/// number of stances checked, and the earliest and latest heel rise (the first frame after
+/// foot flat with the heel more than 1 mm up) as fractions of the gait cycle (heel strike to
+/// the same foot's next heel strike), over the stances with a next heel strike.
+fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
     let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
     let opts = WalkOptions {
         height_m: h,
@@ -24,6 +26,7 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize) {
     let fps = m.fps();
     let frame = |t: f64| (t * fps).round() as usize;
     let (mut worst, mut lead, mut n) = (0.0f64, i64::MAX, 0);
+    let mut rise = [f64::INFINITY, f64::NEG_INFINITY];
     for e in m.events.iter().filter(|e| e.kind == EventKind::FootFlat) {
         let Some(off) = m
             .events
@@ -47,34 +50,59 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize) {
         }
         lead = lead.min(ho as i64 - mid as i64);
         n += 1;
+        let strikes = || {
+            m.events
+                .iter()
+                .filter(|o| o.kind == EventKind::HeelStrike && o.side == e.side)
+        };
+        let hs = strikes().rfind(|o| o.time_s <= e.time_s);
+        let next = strikes().find(|o| o.time_s > e.time_s);
+        let up = (ff..m.len()).find(|&i| m.landmark(i, heel).y > 1e-3);
+        if let (Some(hs), Some(next), Some(up)) = (hs, next, up) {
+            let f = (up as f64 / fps - hs.time_s) / (next.time_s - hs.time_s);
+            rise = [rise[0].min(f), rise[1].max(f)];
+        }
     }
-    (worst, lead, n)
+    (worst, lead, n, rise)
 }
 
 /// Measured (8 steps, steady start, frame rate 100/s), the heel's highest from foot flat to the
 /// later of heel off and midstance, 1.5/1.8/2.0 m, with the paper's sagittal lock at the straight
 /// leg's length: 3 km/h 3.98/4.90/5.54 mm, 5 km/h 4.01/4.94/5.58, 7 km/h 4.24/5.14/5.75 (heel
 /// off 9–28 frames before midstance). With the projected lock (Froude 0.24–0.65,
-/// `generate::PROJECTED_LOCK_FROUDE_MIN`/`MAX`): ≤ 0.01 mm at 3–6 km/h and 7 km/h × 2.0 m. The
-/// walks outside that range keep the hover (1–2 km/h 2.3–5.5 mm, 7 km/h × 1.5/1.8 m 4.2/5.1):
-/// asserted above 1 mm so that a fix there is noticed.
+/// `generate::PROJECTED_LOCK_FROUDE_MIN`/`MAX`): ≤ 0.01 mm at 3–6 km/h and 7 km/h × 2.0 m.
+/// Above Froude 0.65 (7 km/h × 1.5/1.8 m) the drawn midstance knee takes the 3-D reach
+/// instead (`StanceSpec::flat_reach`): 4.24/5.14 → 0.00 mm. The walks below Froude 0.24 keep
+/// the hover (1–2 km/h 2.3–5.5 mm): asserted above 1 mm so that a fix there is noticed.
+///
+/// Where the heel stays down it rises (1 mm) at 37–43 % of the gait cycle (3 km/h 37–39 %,
+/// 5 km/h 40–42 %, 7 km/h 41–43 %): a human's heel off is at 30–40 %, so up to 3 % late at
+/// 5–7 km/h; asserted within 30–45 %. The hovering walks' heels are 1 mm up at 5–8 %.
 #[test]
 fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
     let mut failed = Vec::new();
     let mut still = Vec::new();
     for kmh in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0] {
         for h in [1.5, 1.8, 2.0] {
-            let (worst, lead, n) = heel_hover(kmh, h);
+            let (worst, lead, n, rise) = heel_hover(kmh, h);
             println!(
                 "{kmh} km/h × {h} m: heel ≤ {:.2} mm from foot flat to heel off / midstance, \
-                 heel off ≥ {lead} frames after midstance ({n} stances)",
-                1e3 * worst
+                 heel off ≥ {lead} frames after midstance ({n} stances), heel up 1 mm at \
+                 {:.0}–{:.0} % of the cycle",
+                1e3 * worst,
+                100.0 * rise[0],
+                100.0 * rise[1]
             );
-            let fixed = kmh >= 3.0 && (kmh < 7.0 || h >= 2.0);
-            if n < 6 || (fixed && worst > 1e-3) {
+            let fixed = kmh >= 3.0;
+            // Where the heel stays down, it rises where a human's does (30–40 % of the
+            // cycle), a little late at speed.
+            let timed = rise[0] >= 0.30 && rise[1] <= 0.45;
+            if n < 6 || (fixed && (worst > 1e-3 || !timed)) {
                 failed.push(format!(
-                    "{kmh} km/h × {h} m: {:.2} mm, {n} stances",
-                    1e3 * worst
+                    "{kmh} km/h × {h} m: {:.2} mm, {n} stances, heel up at {:.2}–{:.2}",
+                    1e3 * worst,
+                    rise[0],
+                    rise[1]
                 ));
             }
             if !fixed && worst <= 1e-3 {

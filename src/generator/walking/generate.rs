@@ -301,13 +301,29 @@ fn num_err(stage: String, message: String) -> GenerateError {
 /// eased knee (`virtual_leg::KNEE_EASE`) rolls the foot from foot flat on; with the lower hip
 /// the landing knee jumped (measured, 8 steps: 1 km/h × 2.0 m 4.65 → 111 at foot flat, 2 km/h ×
 /// 1.5 m 4.0 → 10.6 at heel strike), so those walks keep the paper's lock.
+///
+/// Why the lower lock cannot reach there (measured, 1 km/h × 1.8 m): the leg lands 12 mm
+/// longer than `l1`, turns 1 mm short of it ≈ 0.1 s into the stance and locks where it turns,
+/// 4 mm above the projected lock; only a shorter spring rest length lowers it. That fixes
+/// 2 km/h (heel ≤ 0.34 mm; 1 km/h 0.6–1.9 mm) but moves gaitfit's default
+/// (foot-speed) double support at 1.5 km/h × 1.6 m from +23 to +40 ms: the heel strike is
+/// seen 9.5 ms earlier (the swing heel slows to 0.19 m/s 1 cm above the floor 9 frames before
+/// contact, under the 0.5 × walking speed threshold) and the toe off 6 ms later (the toe
+/// leaves at 0.33 instead of 0.42 m/s), so the walks below keep the hover.
 pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.24;
 
-/// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m).
+/// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m);
+/// above it the drawn knee takes the same reach instead (`StanceSpec::flat_reach`, through
+/// `StanceSpec::drawn_span`: the midstance knee drawn with the 3-D leg's flexion), so the
+/// stance heel stays down at every speed from [`PROJECTED_LOCK_FROUDE_MIN`] on.
 ///
-/// Why not above: at 7 km/h × 1.5/1.8 m (Froude 0.73 / 0.67) the heel strikes improved but the
-/// walk's first and last frames got worse (measured, 8 steps: 11.4 → 20.6 at frame 2, the
-/// trailing toe; 6.44 → 9.48 at the last frame, the shoulder), beyond their guards.
+/// Why not the lower lock above: at 7 km/h × 1.5/1.8 m (Froude 0.73 / 0.67) the heel strikes
+/// improved but the walk's first and last frames got worse (measured, 8 steps: 11.4 → 20.6 at
+/// frame 2, the trailing toe; 6.44 → 9.48 at the last frame, the shoulder), beyond their
+/// guards. Both are the record's edges, where the continuity window is cut: frame 2 is the last
+/// pre-roll stance's toe bend coming to its limit just before toe off (7.8 with that one
+/// stance at the paper's lock), and the shoulder's step at every heel strike grew (7 km/h ×
+/// 1.8 m, frame 282: 0.0072 → 0.0107 rad), hidden inside the walk by the larger steps after it.
 pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
 
 /// Whether a stance at `speed` m/s of a body with unloaded leg `l1` locks at the sagittal
@@ -601,6 +617,7 @@ pub fn generate_steps(
             },
             lock_short: 0.0,
             lock_reach: 0.0,
+            flat_reach: 0.0,
         };
         // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
         let lock_short = super::stance::lock_shortening(spec.push_off);
@@ -617,13 +634,16 @@ pub fn generate_steps(
             .fold(0.0, f64::max);
         let lock_full = body.l1 * (1.0 - lock_short);
         let lock_flat = lock_full - 2.0 * KNEE_SOFT - STAND_MARGIN;
+        let flat_reach = lock_full - (lock_flat * lock_flat - dz_max * dz_max).max(0.0).sqrt();
+        // Where the lock is not shortened by it, the drawn knee takes it (`drawn_span`).
         let spec = StanceSpec {
             lock_short,
             lock_reach: if projected_lock(l.speed_m_per_s, body.l1, from_rest || to_rest) {
-                lock_full - (lock_flat * lock_flat - dz_max * dz_max).max(0.0).sqrt()
+                flat_reach
             } else {
                 0.0
             },
+            flat_reach,
             ..spec
         };
         let (st_solved, st_run) = spec

@@ -158,6 +158,11 @@ pub struct StanceSpec {
     /// its flat foot with the virtual leg's soft knee, m (0: none; see
     /// [`StanceSpec::lock_length`]).
     pub lock_reach: f64,
+    /// How much longer the drawn 3-D leg's hip–flat-ankle distance is at the lock than the
+    /// sagittal rigid leg, plus the virtual leg's soft knee (`2σ` and a margin), m: what the lock
+    /// must be shortened by ([`StanceSpec::lock_reach`]), or the drawn span lengthened by
+    /// ([`StanceSpec::drawn_span`]), for the flat foot to stay within reach (0: none).
+    pub flat_reach: f64,
 }
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
@@ -256,7 +261,8 @@ impl StanceSpec {
     /// up from foot flat to heel off. The rigid leg here is the sagittal projection of the 3-D
     /// leg with that soft knee (`lock_reach`, set by the generator from the stance's largest
     /// `dz`, at Froude speeds 0.24–0.65: `generate::PROJECTED_LOCK_FROUDE_MIN`), so the stance
-    /// heel stays down until the extension lifts it.
+    /// heel stays down until the extension lifts it. Above that speed the drawn knee takes the
+    /// same reach instead ([`StanceSpec::drawn_span`]).
     pub fn lock_length(&self) -> f64 {
         self.l1 * (1.0 - self.lock_short.max(0.0)) - self.lock_reach.max(0.0)
     }
@@ -269,7 +275,18 @@ impl StanceSpec {
     /// longer by as much as the leg locked above that length where it turned, up to `leg_span`
     /// (the paper's straight knee: the first step at a new, faster speed, whose hip comes in
     /// high); `leg_span` when it never locked or `lock_short` is 0. `lock_reach` does not
-    /// shorten it: it is the drawn leg's lateral geometry, not a knee flexion to keep.
+    /// shorten it: it is the drawn leg's lateral geometry, not a knee flexion to keep. The part
+    /// of [`StanceSpec::flat_reach`] the lock does not take (`flat_reach − lock_reach`)
+    /// lengthens it, up to `leg_span`: the midstance knee is drawn with the 3-D leg's flexion.
+    ///
+    /// Why the 3-D leg's flexion (a change to the paper's planar virtual leg, issue 6): the
+    /// rigid leg is sagittal, the drawn hip `dz` beside the foot, so a knee drawn for the
+    /// sagittal length `l1 (1 − δ)` left the flat ankle ≈ `dz²/2l` + the soft knee's `2σ` out of
+    /// reach and the foot rolled onto its ball: the heel hovered 4.2 / 5.1 mm from foot flat to
+    /// heel off at 7 km/h × 1.5 / 1.8 m, where the lock is not shortened by the reach (its
+    /// lower hip made the arms jolt harder at heel strike, see
+    /// `generate::PROJECTED_LOCK_FROUDE_MAX`). Drawn with the 3-D span the heel stays down
+    /// (0.00 mm) and the dynamics, hence every continuity ratio, are unchanged.
     ///
     /// Why the turned lock keeps its knee: with `lock_reach` more legs lock where they turn
     /// just above the lock length; drawn with the straight leg's span their knee straightened
@@ -286,10 +303,12 @@ impl StanceSpec {
         // A leg that locked where it turned above the lock length keeps the knee it turned
         // with (the span grows by as much, up to the straight leg).
         let short = self.l1 * self.lock_short.max(0.0);
+        // The flat foot's reach the lock left to the drawn knee.
+        let reach = (self.flat_reach - self.lock_reach.max(0.0)).max(0.0);
         match run.lock_time {
             Some(t) if short > 0.0 => {
                 let above = (run.track.at(t).0[0] - self.lock_length()).max(0.0);
-                (leg_span - short + above).min(leg_span)
+                (leg_span - short + above + reach).min(leg_span)
             }
             _ => leg_span,
         }
@@ -586,6 +605,7 @@ mod tests {
             push_off: 2.0,
             lock_short: 0.0,
             lock_reach: 0.0,
+            flat_reach: 0.0,
         };
         let start = StanceStart {
             q: [
@@ -809,6 +829,31 @@ mod tests {
         assert!(span > leg_span - 0.02 * spec.l1 + 5e-4);
         // Without the shortening, never shortened.
         assert_eq!(spec.drawn_span(&run, leg_span), leg_span);
+        // The flat foot's reach the lock does not take lengthens the drawn span (the 3-D leg's
+        // knee), never beyond the straight leg; the part the lock takes does not.
+        let reach = StanceSpec {
+            flat_reach: 0.005,
+            ..short
+        };
+        let longer = reach.drawn_span(&run, leg_span);
+        assert!(
+            (longer - (span + 0.005).min(leg_span)).abs() < 1e-12 && longer > span + 1e-3,
+            "{longer} vs {span} (leg {leg_span})"
+        );
+        let taken = StanceSpec {
+            lock_reach: 0.003,
+            ..reach
+        };
+        let run = taken.run(&start, 76.0, 0.0, taken.step(&start), true);
+        let w = run.track.at(run.lock_time.expect("locked")).0[0];
+        let above = (w - taken.lock_length()).max(0.0);
+        let expected = (leg_span - 0.02 * spec.l1 + above + 0.002).min(leg_span);
+        assert!((taken.drawn_span(&run, leg_span) - expected).abs() < 1e-12);
+        let wide = StanceSpec {
+            flat_reach: 0.05,
+            ..short
+        };
+        assert_eq!(wide.drawn_span(&run, leg_span), leg_span);
     }
 
     #[test]
