@@ -9,8 +9,9 @@
 //! heel strike, its ankle spike judged against later steps only) and 5 km/h (1.8, 2.0 m, since the landing ankle's contact rate
 //! `generate::MAX_CONTACT_ANKLE_RATE` went 3 → 6 rad/s) and 6 km/h (2.0 m, since the trailing
 //! knee's hold through the double support, `hold_knees` in `generate.rs`) and 7 km/h (2.0 m,
-//! since the stance leg locks at the projection of the drawn 3-D leg, klawflat) — asserted as
-//! `passed` below — and not yet elsewhere
+//! since the stance leg locks at the projection of the drawn 3-D leg, klawflat), and the
+//! standing-start schedule at 1.5 m (since the landing ankle's contact ramp,
+//! `SwingFoot::contact_ramp`, klawhs2) — asserted as `passed` below — and not yet elsewhere
 //! (2026-11-27, klawpush: 2 km/h 5.2–6.4, 4–7 km/h 6.1–12.4, worst at heel strike, where KLAW's
 //! hip closes on the landing heel at 0.98–1.54 m/s (5–7 km/h, 1.8 m), and at frame 0 of a steady
 //! walk, the same spike with no history — until the lead-in, klawlead s7). There the worst ratios measured on main are asserted with 25 %
@@ -74,8 +75,56 @@ fn continuity_is_met_at_1_to_7_kmh() {
             failures.push(report);
         }
     }
+    // The standing-start schedule 2 → 5 → 3 km/h with its stop, at 1.5 m (since the landing
+    // ankle's contact ramp, `SwingFoot::contact_ramp`: 5.56 → 4.60).
+    let (w, report) = worst(&[(2.0, 4), (5.0, 4), (3.0, 4)], 1.5, true);
+    println!("schedule 1.5 m: {report}");
+    if w > ContinuityOptions::default().k {
+        failures.push(report);
+    }
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// The heel strikes of the fast walks of short bodies, away from the walk's two ends (8 steps,
+/// steady start; the steps from frame 3 to the fourth-last frame: frame 0 of a steady start is
+/// the first heel strike with no frames before it in the window, and the last frames have none
+/// after, both left to the recording of the walk's ends). Since the landing ankle's contact
+/// ramp (`SwingFoot::contact_ramp`), 4–6 km/h × 1.5 m and 7 km/h × 1.8 m meet k = 5 there
+/// (their worst heel strikes were 4.5, 5.3, 7.7 and 6.4); 7 km/h × 1.5 m, a 1.5 m body at the
+/// walk–run transition (Froude 0.73), is guarded at 1.25 × its measurement (11.4 before).
+#[test]
+fn fast_short_heel_strikes_meet_k5_away_from_the_ends() {
+    let o = ContinuityOptions::default();
+    let mut failures = Vec::new();
+    for (kmh, h, bound) in [
+        (4.0, 1.5, o.k),
+        (5.0, 1.5, o.k),
+        (6.0, 1.5, o.k),
+        (7.0, 1.8, o.k),
+        (7.0, 1.5, HS_7KMH_1_5M),
+    ] {
+        let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
+        let opts = WalkOptions {
+            height_m: h,
+            ..Default::default()
+        };
+        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let r = continuity_over(&m, &o, 3..m.len() - 4);
+        println!("{kmh} km/h {h} m, frames 3..{}: {r}", m.len() - 4);
+        assert!(
+            r.examined > 1000,
+            "{kmh} km/h {h} m: {} examined",
+            r.examined
+        );
+        if r.worst > bound {
+            failures.push(format!("{kmh} km/h {h} m: {r} (bound {bound})"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// 7 km/h × 1.5 m away from the walk's ends: measured 5.3 (the heel strikes, r/l_ankle) × 1.25.
+const HS_7KMH_1_5M: f64 = 1.25 * 5.3;
 
 /// (schedule as (km/h, steps), height m, from rest with stop, bound on the worst ratio).
 type Case = (&'static [(f64, usize)], f64, bool, f64);

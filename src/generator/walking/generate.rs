@@ -367,8 +367,26 @@ const CONTACT_RATE_WINDOW: f64 = 0.01;
 /// meet k = 5 —, 6 km/h 11.3/7.96/10.5 → 10.7/6.46/10.5, 7 km/h 12.4/10.8/7.82 →
 /// 11.0/10.2/6.15; frame 0 of a steady start, which has no pre-contact frames, is now the worst
 /// at 4–6 km/h and is unchanged). 10 rad/s took 7 km/h × 1.8 m's heel strikes further (≤ 7.2)
-/// but is beyond what a human ankle does just before contact; not taken.
+/// but is beyond what a human ankle does just before contact; not taken. The swing ankle's
+/// rate rises to it over the last 4–6 frames before the contact
+/// ([`super::swing::SwingFoot::contact_ramp`], klawhs2), not within the last one or two.
 pub const MAX_CONTACT_ANKLE_RATE: f64 = 6.0;
+
+/// Weight of the swing ankle's contact ramp ([`super::swing::SwingFoot::contact_ramp`]) for a
+/// landing whose stance ankle turns at `rate` rad/s just after heel strike: 0 up to
+/// [`MAX_CONTACT_ANKLE_RATE`] (the swing3 cubic matches such a rate in full, and the paper's
+/// ending is kept), rising linearly to 1 at twice it.
+///
+/// Why: the ramp is needed where the stance roll outruns the swing ankle's cap — the fast walks
+/// of short bodies (measured |rate| 12–17.5 rad/s at 5–7 km/h × 1.5 m, 13.3 at 7 km/h × 1.8 m,
+/// 10–12 at the 5 km/h steps of the 2 → 5 → 3 km/h schedule at 1.5 m); in slower walks
+/// (3 km/h × 1.7 m: 6.75, 4–5 km/h × 1.8–2.0 m: 6.6–8.0) the full ramp plantarflexed the ankle
+/// earlier than needed and the heel slowed earlier before contact: the default (foot-speed)
+/// events saw the double support at 3 km/h × 1.7 m 31 ms too long (`klaw_events`, within
+/// 30 ms before).
+pub fn contact_ramp_weight(rate: f64) -> f64 {
+    ((rate.abs() - MAX_CONTACT_ANKLE_RATE) / MAX_CONTACT_ANKLE_RATE).clamp(0.0, 1.0)
+}
 
 /// How much later (fraction of the swing) swing1 ends in the last step before a stop, a half
 /// step whose swing foot travels 1.5 step lengths to a heel strike only half a step ahead.
@@ -791,8 +809,10 @@ pub fn generate_steps(
             (data.last_mut(), theta5_early.first(), theta5_early.last())
         {
             if b.0 > a.0 {
-                prev.swing_foot.theta5_rate_hs = ((b.1 - a.1) / (b.0 - a.0))
-                    .clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+                let rate = (b.1 - a.1) / (b.0 - a.0);
+                prev.swing_foot.theta5_rate_hs =
+                    rate.clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+                prev.swing_foot.contact_ramp_weight = contact_ramp_weight(rate);
             }
         }
         // 4. Swing.
@@ -989,9 +1009,9 @@ pub fn generate_steps(
     // The last step's swing foot lands into the stop's heel rocker as every other lands into
     // the next step's: its ankle ends swing3 at the rocker's early ankle rate.
     if let (Some(c), Some(d)) = (closing.as_ref(), data.last_mut()) {
-        d.swing_foot.theta5_rate_hs = c
-            .contact_ankle_rate(CONTACT_RATE_WINDOW)
-            .clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+        let rate = c.contact_ankle_rate(CONTACT_RATE_WINDOW);
+        d.swing_foot.theta5_rate_hs = rate.clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
+        d.swing_foot.contact_ramp_weight = contact_ramp_weight(rate);
     }
     let total = t_global + closing.as_ref().map_or(0.0, |c| c.duration);
     let motion = assemble(&skeleton, &body, &foot, &data, opt, total, closing.as_ref())?;
