@@ -170,7 +170,7 @@ const BOUND_7KMH: f64 = 5.0; // measured 4.01 (frame 5, l_ankle, since the conta
 // 4.55 with klawhs' contact rate 6 rad/s: asserted in `continuity_is_met_at_1_to_7_kmh`.
 // klawflat (the stance leg locks at the projection of the drawn 3-D leg): 7 km/h × 2.0 m
 // 5.32 → 4.61 (frame 348, r_ankle): asserted there; 6 km/h × 2.0 m 4.24 → 3.60.
-const BOUND_SCHEDULE: f64 = 5.0; // meets k = 5: measured 4.71 (frame 865, l_ankle, since the stop's swings are braked; 6.08 at 851, l_knee, the unbraked last swing's knee at its lock, before); 6.08 (frame 851, l_knee, the stop's last swing, since the speed-up's push-off, `generate::speeds_up`; 6.20 at 362, r_knee, the trailing knee of the first 5 km/h step, before); 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
+const BOUND_SCHEDULE: f64 = 4.6; // meets k = 5: measured 3.70 (frame 100, r_knee, the start, since the default speed-change limit ramps 2 -> 3.5 -> 5 -> 4 -> 3 km/h, `max_speed_change_m_per_s` = 0.5); 4.71 (frame 865, l_ankle, since the stop's swings are braked; 6.08 at 851, l_knee, the unbraked last swing's knee at its lock, before); 6.08 (frame 851, l_knee, the stop's last swing, since the speed-up's push-off, `generate::speeds_up`; 6.20 at 362, r_knee, the trailing knee of the first 5 km/h step, before); 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
 
 /// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
 fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
@@ -416,6 +416,66 @@ fn the_trailing_knee_does_not_straighten_in_double_support() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// A 1 → 7 km/h schedule (4 steps each, from standing, with a stop) is ramped by the default
+/// `max_speed_change_m_per_s` = 0.5 m/s per step (1 → 2.5 → 4 → 5.5 → 7 km/h) and stays within
+/// the bounds measured with it (× 1.25). In one step (the limit off) the same walk scored 128.9 /
+/// 153.9 / 5.36 at 1.5 / 1.8 / 2.0 m: the trailing leg of the first 7 km/h step.
+#[test]
+fn a_large_speed_change_is_ramped_and_stays_continuous() {
+    // (height, bound = measured × 1.25)
+    let cases = [
+        // measured 5.80 (frame 633, r_ankle, a 7 km/h heel strike; steady 7 km/h × 1.5 m
+        // scores 11.4 at its heel strikes).
+        (1.5, 7.3),
+        // measured 4.98 (frame 111, r_knee, the start): meets k = 5.
+        (1.8, 6.2),
+        // measured 32.0 (frame 609, l_toe): not the ramp's doing but `generate::speeds_up`
+        // snapping a still-flat stance foot into meta-off (toe 22 mm in one frame) when a
+        // 1 km/h stance leg toes off in a faster step after another speed-up (1 -> 1.5 km/h in
+        // one step scores 112 there on main before this change). Kept as a guard until fixed.
+        (2.0, 40.0),
+    ];
+    let mut failures = Vec::new();
+    for (h, bound) in cases {
+        let opts = WalkOptions {
+            height_m: h,
+            start_from_rest: true,
+            stop: true,
+            ..Default::default()
+        };
+        let schedule = [
+            ScheduleEntry::at_speed(1.0 / 3.6, 4),
+            ScheduleEntry::at_speed(7.0 / 3.6, 4),
+        ];
+        let (m, report) = generate_walk(&schedule, &opts).unwrap();
+        // The ramp: 3 of the 7 km/h stretch's 4 steps, the last a half step (the stop).
+        let kmh: Vec<f64> = report
+            .steps
+            .iter()
+            .map(|s| s.step_length_m * s.step_freq_steps_per_min / 60.0 * 3.6)
+            .collect();
+        let expect = [1.0, 1.0, 1.0, 1.0, 2.5, 4.0, 5.5, 3.5];
+        assert!(
+            kmh.len() == expect.len() && kmh.iter().zip(expect).all(|(a, b)| (a - b).abs() < 1e-6),
+            "{kmh:?}"
+        );
+        assert!(
+            m.metadata
+                .notes
+                .iter()
+                .any(|n| n.contains("max_speed_change_m_per_s")),
+            "{:?}",
+            m.metadata.notes
+        );
+        let r = continuity(&m, &ContinuityOptions::default());
+        println!("1 -> 7 km/h {h} m: {r}");
+        if r.worst > bound {
+            failures.push(format!("{h} m: ratio {:.2} > {bound}", r.worst));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:?}");
+}
+
 /// A speed-up's trailing leg pushes off (`generate::speeds_up`): in the double support of the
 /// first faster step of 2 → 4 and 2 → 5 km/h (4 steps each, from standing, with a stop,
 /// 1.5/1.8/2.0 m) the trailing knee never straightens by more than 1 mrad in a frame (the
@@ -428,12 +488,15 @@ fn a_speed_up_pushes_off_with_the_trailing_knee() {
     let mut failures = Vec::new();
     for fast in [4.0, 5.0] {
         for h in [1.5, 1.8, 2.0] {
-            let opts = WalkOptions {
+            let mut opts = WalkOptions {
                 height_m: h,
                 start_from_rest: true,
                 stop: true,
                 ..Default::default()
             };
+            // The paper's one-step change (0.56 and 0.83 m/s), not the default ramp: this
+            // tests the push-off of a large one-step speed-up.
+            opts.attributes.max_speed_change_m_per_s = 10.0;
             let schedule = [
                 ScheduleEntry::at_speed(2.0 / 3.6, 4),
                 ScheduleEntry::at_speed(fast / 3.6, 4),

@@ -210,6 +210,15 @@ attributes! {
     elbow_flexion_deg: 15.0, [0.0, 90.0], "deg";
     /// Fraction of the pelvic rotation counter-rotated by the thoracic spine and shoulders.
     spine_compensation: 1.0, [0.0, 2.0], "1";
+    /// Largest change of walking speed from one step to the next, m/s per step. A schedule's
+    /// larger change between stretches is spread over as many steps as it needs, at equal
+    /// increments of speed (`generate_walk`). Default 0.5: within what people do
+    /// (walking accelerations ≲ 0.5–1 m/s², ≈ 0.3–0.6 m/s per step) and below the largest
+    /// one-step change the generator handles about as well as steady walking (0.83 m/s, e.g.
+    /// 2 → 5 km/h; 1.11 m/s, 1 → 5 or 3 → 7 km/h, breaks the continuity check); of 0.4, 0.5, 0.6
+    /// and 0.85 it left the fewest of 126 schedule changes (1–7 km/h, 1.5/1.8/2.0 m) above a
+    /// continuity ratio of 10. 10 turns the ramps off (the paper's one-step changes, §2.4).
+    max_speed_change_m_per_s: 0.5, [0.05, 10.0], "m/s";
     /// Largest integration step (the stability bound may make it smaller). 4 ms: the shooting
     /// absorbs the integration error into the forces, which then differ by at most 0.2 % from a
     /// 0.5 ms integration (5 km/h, h = 1.8 m), at an eighth of the cost.
@@ -238,5 +247,26 @@ mod tests {
             .to_string()
             .contains("unknown"));
         assert!(ATTRIBUTES.len() >= 28);
+    }
+
+    #[test]
+    fn the_speed_change_limit_is_range_checked() {
+        let mut a = WalkAttributes::default();
+        assert_eq!(a.max_speed_change_m_per_s, 0.5);
+        a.set("max_speed_change_m_per_s", 0.3).unwrap();
+        assert_eq!(a.get("max_speed_change_m_per_s"), Some(0.3));
+        for bad in [0.0, 0.04, -0.5, 10.5, f64::NAN, f64::INFINITY] {
+            let e = a
+                .set("max_speed_change_m_per_s", bad)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("max_speed_change_m_per_s") && e.contains("0.05 to 10 m/s"),
+                "{e}"
+            );
+        }
+        // A walk's options are validated as a whole, too.
+        a.max_speed_change_m_per_s = 0.0;
+        assert!(a.validate().is_err());
     }
 }

@@ -103,27 +103,16 @@ pub fn steps_for_duration(
 /// travels one step length, half a stride; the hip, starting at rest, half a step); with
 /// `opts.stop` the last step is a half step, after which the trailing foot is brought alongside
 /// and the body comes to rest ([`stop`]).
+///
+/// A change of speed between stretches larger than the attribute `max_speed_change_m_per_s`
+/// (per step) is ramped ([`ramp_schedule`]); the walk's `metadata.notes` and the report's notes
+/// say where.
 pub fn generate_walk(
     schedule: &[ScheduleEntry],
     opts: &WalkOptions,
 ) -> Result<(Motion, WalkReport), GenerateError> {
-    let mut steps = Vec::new();
-    for (i, e) in schedule.iter().enumerate() {
-        let l = high_level::complete(&e.params, opts.height_m, &opts.relations, &opts.attributes)
-            .map_err(|err| match err {
-            GenerateError::Parameter {
-                name,
-                value,
-                message,
-            } => GenerateError::Parameter {
-                name,
-                value,
-                message: format!("schedule entry {}: {message}", i + 1),
-            },
-            other => other,
-        })?;
-        steps.extend(std::iter::repeat_n(l, e.steps));
-    }
+    opts.attributes.validate()?;
+    let (mut steps, ramps) = ramp_schedule(schedule, opts)?;
     if steps.is_empty() {
         return Err(GenerateError::Parameter {
             name: "steps".into(),
@@ -147,7 +136,101 @@ pub fn generate_walk(
             f.speed_m_per_s *= 0.5;
         }
     }
-    generate::generate_steps(&steps, opts)
+    let (mut motion, mut report) = generate::generate_steps(&steps, opts)?;
+    motion.metadata.notes.extend(ramps.iter().cloned());
+    report.notes.extend(ramps);
+    Ok((motion, report))
+}
+
+/// The schedule's steps, each completed by eq. 1 ([`high_level::complete`]), with every change
+/// of speed between stretches larger than `max_speed_change_m_per_s` spread over
+/// n = ⌈|Δv| / limit⌉ steps at equal increments of speed (the paper changes speed in one step,
+/// §2.4, whatever the size: no one changes walking speed by 1.7 m/s in one step, and the
+/// generator breaks the continuity check from about 1.1 m/s per step). Returns the steps and
+/// one note per ramped change.
+///
+/// - The ramp's n − 1 intermediate steps are taken out of the new stretch, so that the schedule
+///   keeps its step count (and a duration its time). A stretch shorter than its ramp ramps all
+///   along and ends short of its speed; the next change starts from there.
+/// - The intermediate steps walk naturally at their speed (eq. 1) when both stretches are given
+///   by their speed alone; otherwise their step length is interpolated linearly between the two
+///   stretches' (completed) step lengths and the step frequency follows from the speed.
+/// - The first step from standing and the stop's half step are not ramped: they are the start
+///   and the stop of §2.4, with their own from-rest kinematics (measured separately).
+pub fn ramp_schedule(
+    schedule: &[ScheduleEntry],
+    opts: &WalkOptions,
+) -> Result<(Vec<Locomotion>, Vec<String>), GenerateError> {
+    let entry_err = |i: usize, what: &str, err: GenerateError| match err {
+        GenerateError::Parameter {
+            name,
+            value,
+            message,
+        } => GenerateError::Parameter {
+            name,
+            value,
+            message: format!("schedule entry {}{what}: {message}", i + 1),
+        },
+        other => other,
+    };
+    let complete =
+        |p: &WalkParams| high_level::complete(p, opts.height_m, &opts.relations, &opts.attributes);
+    let limit = opts.attributes.max_speed_change_m_per_s;
+    let mut steps: Vec<Locomotion> = Vec::new();
+    let mut notes = Vec::new();
+    // Whether the last step walked naturally at its speed (given by its speed alone).
+    let mut last_natural = true;
+    for (i, e) in schedule.iter().enumerate() {
+        let target = complete(&e.params).map_err(|err| entry_err(i, "", err))?;
+        let natural =
+            e.params.step_length_m.is_none() && e.params.step_freq_steps_per_min.is_none();
+        let mut left = e.steps;
+        if let (Some(&from), true) = (steps.last(), e.steps > 0) {
+            let dv = target.speed_m_per_s - from.speed_m_per_s;
+            // 1e-9: a change of exactly the limit is one step.
+            let n = ((dv.abs() / limit) - 1e-9).ceil().max(1.0) as usize;
+            if n > 1 {
+                let ramp = (n - 1).min(e.steps);
+                for k in 1..=ramp {
+                    let f = k as f64 / n as f64;
+                    let v = from.speed_m_per_s + f * dv;
+                    let p = WalkParams {
+                        speed_m_per_s: Some(v),
+                        step_length_m: (!(natural && last_natural)).then(|| {
+                            from.step_length_m + f * (target.step_length_m - from.step_length_m)
+                        }),
+                        step_freq_steps_per_min: None,
+                    };
+                    steps.push(complete(&p).map_err(|err| entry_err(i, " (ramp step)", err))?);
+                }
+                left -= ramp;
+                let reached = steps
+                    .last()
+                    .map_or(target.speed_m_per_s, |s| s.speed_m_per_s);
+                notes.push(format!(
+                    "schedule entry {}: speed change {:.2} -> {:.2} m/s exceeds \
+                     max_speed_change_m_per_s = {limit} per step; ramped over {} step(s) taken \
+                     from the entry{}",
+                    i + 1,
+                    from.speed_m_per_s,
+                    target.speed_m_per_s,
+                    ramp + usize::from(left > 0),
+                    if left == 0 {
+                        format!(
+                            ", which is too short: it ends at {reached:.2} m/s, short of its speed"
+                        )
+                    } else {
+                        String::new()
+                    }
+                ));
+            }
+        }
+        steps.extend(std::iter::repeat_n(target, left));
+        if e.steps > 0 {
+            last_natural = natural;
+        }
+    }
+    Ok((steps, notes))
 }
 
 /// Reads a schedule CSV: one row per stretch with columns `steps` and any of `speed_m_per_s`
@@ -224,4 +307,112 @@ pub fn read_schedule(path: &Path) -> Result<Vec<ScheduleEntry>, GenerateError> {
         });
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn kmh(v: f64, steps: usize) -> ScheduleEntry {
+        ScheduleEntry::at_speed(v / 3.6, steps)
+    }
+
+    fn speeds_kmh(schedule: &[ScheduleEntry], opts: &WalkOptions) -> (Vec<f64>, Vec<String>) {
+        let (steps, notes) = ramp_schedule(schedule, opts).unwrap();
+        let v = steps.iter().map(|s| s.speed_m_per_s * 3.6).collect();
+        (v, notes)
+    }
+
+    fn close(a: &[f64], b: &[f64]) -> bool {
+        a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9)
+    }
+
+    #[test]
+    fn a_large_speed_change_is_ramped_out_of_the_new_stretch() {
+        let opts = WalkOptions::default();
+        assert_eq!(opts.attributes.max_speed_change_m_per_s, 0.5);
+        // 1 -> 7 km/h is 1.67 m/s: n = ceil(1.67 / 0.5) = 4 steps of 1.5 km/h, the first three
+        // taken out of the 7 km/h stretch (the schedule keeps its 10 steps).
+        let (v, notes) = speeds_kmh(&[kmh(1.0, 4), kmh(7.0, 6)], &opts);
+        assert!(
+            close(&v, &[1.0, 1.0, 1.0, 1.0, 2.5, 4.0, 5.5, 7.0, 7.0, 7.0]),
+            "{v:?}"
+        );
+        assert_eq!(notes.len(), 1);
+        assert!(
+            notes[0].contains("schedule entry 2") && notes[0].contains("4 step(s)"),
+            "{notes:?}"
+        );
+        // Down as well: 5 -> 3 km/h (0.56 m/s) takes 2 steps.
+        let (v, _) = speeds_kmh(&[kmh(5.0, 2), kmh(3.0, 3)], &opts);
+        assert!(close(&v, &[5.0, 5.0, 4.0, 3.0, 3.0]), "{v:?}");
+        // The intermediate steps of natural stretches walk naturally (eq. 1) at their speed.
+        let (steps, _) = ramp_schedule(&[kmh(1.0, 1), kmh(7.0, 4)], &opts).unwrap();
+        let natural = high_level::complete(
+            &WalkParams {
+                speed_m_per_s: Some(4.0 / 3.6),
+                ..Default::default()
+            },
+            opts.height_m,
+            &opts.relations,
+            &opts.attributes,
+        )
+        .unwrap();
+        assert_eq!(steps[2], natural);
+    }
+
+    #[test]
+    fn a_change_within_the_limit_is_untouched() {
+        let opts = WalkOptions::default();
+        // 2 -> 3.8 km/h is exactly 0.5 m/s; 3.8 -> 3 km/h is 0.22 m/s.
+        let (v, notes) = speeds_kmh(&[kmh(2.0, 2), kmh(3.8, 2), kmh(3.0, 2)], &opts);
+        assert!(close(&v, &[2.0, 2.0, 3.8, 3.8, 3.0, 3.0]), "{v:?}");
+        assert!(notes.is_empty(), "{notes:?}");
+        // The limit turned off (10 m/s per step): the paper's one-step change (§2.4).
+        let mut off = WalkOptions::default();
+        off.attributes.max_speed_change_m_per_s = 10.0;
+        let (v, notes) = speeds_kmh(&[kmh(1.0, 2), kmh(7.0, 2)], &off);
+        assert!(close(&v, &[1.0, 1.0, 7.0, 7.0]), "{v:?}");
+        assert!(notes.is_empty());
+    }
+
+    #[test]
+    fn a_stretch_shorter_than_its_ramp_ends_short_of_its_speed() {
+        let opts = WalkOptions::default();
+        // 1 -> 7 km/h needs 4 steps; a 2-step stretch reaches 4 km/h, and the next change
+        // (to 1 km/h, 0.83 m/s: 2 steps) starts from there.
+        let (v, notes) = speeds_kmh(&[kmh(1.0, 2), kmh(7.0, 2), kmh(1.0, 3)], &opts);
+        assert!(close(&v, &[1.0, 1.0, 2.5, 4.0, 2.5, 1.0, 1.0]), "{v:?}");
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(notes[0].contains("too short") && notes[0].contains("1.11 m/s"));
+        assert!(!notes[1].contains("too short"), "{notes:?}");
+    }
+
+    #[test]
+    fn given_step_lengths_are_interpolated_linearly() {
+        let opts = WalkOptions::default();
+        let entry = |v: f64, sl: f64| ScheduleEntry {
+            params: WalkParams {
+                speed_m_per_s: Some(v),
+                step_length_m: Some(sl),
+                step_freq_steps_per_min: None,
+            },
+            steps: 2,
+        };
+        let (steps, _) = ramp_schedule(&[entry(0.5, 0.5), entry(1.5, 0.8)], &opts).unwrap();
+        let sl: Vec<f64> = steps.iter().map(|s| s.step_length_m).collect();
+        assert!(close(&sl, &[0.5, 0.5, 0.65, 0.8]), "{sl:?}");
+        assert!((steps[2].speed_m_per_s - 1.0).abs() < 1e-12);
+        assert!((steps[2].step_freq_steps_per_min - 60.0 / 0.65).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_limit_is_validated_before_ramping() {
+        let mut opts = WalkOptions::default();
+        opts.attributes.max_speed_change_m_per_s = 0.0;
+        let e = generate_walk(&[kmh(1.0, 2), kmh(7.0, 2)], &opts)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("max_speed_change_m_per_s"), "{e}");
+    }
 }
