@@ -196,9 +196,9 @@ pub fn ramp_schedule(
                     let v = from.speed_m_per_s + f * dv;
                     let p = WalkParams {
                         speed_m_per_s: Some(v),
-                        step_length_m: (!(natural && last_natural)).then(|| {
-                            from.step_length_m + f * (target.step_length_m - from.step_length_m)
-                        }),
+                        step_length_m: (!(natural && last_natural)).then_some(
+                            from.step_length_m + f * (target.step_length_m - from.step_length_m),
+                        ),
                         step_freq_steps_per_min: None,
                     };
                     steps.push(complete(&p).map_err(|err| entry_err(i, " (ramp step)", err))?);
