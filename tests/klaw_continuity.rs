@@ -8,7 +8,9 @@
 //! `generate::LEAD_IN_FRAMES` before its first heel strike, klawlead: frame 0 had been that
 //! heel strike, its ankle spike judged against later steps only) and 5 km/h (1.8, 2.0 m, since the landing ankle's contact rate
 //! `generate::MAX_CONTACT_ANKLE_RATE` went 3 → 6 rad/s) and 6 km/h (2.0 m, since the trailing
-//! knee's hold through the double support, `hold_knees` in `generate.rs`) and 7 km/h (2.0 m,
+//! knee's hold through the double support, `hold_knees` in `generate.rs`; 1.8 m since the
+//! recording runs past the last heel strike, `generate::LEAD_OUT_FRAMES`: its last frame had been
+//! the landing thigh's retraction, judged against earlier frames only) and 7 km/h (2.0 m,
 //! since the stance leg locks at the projection of the drawn 3-D leg, klawflat), and the
 //! standing-start schedule at 1.5 m and 5–6 km/h × 1.5 m and 7 km/h × 1.8 m (since the
 //! landing ankle's contact ramp, `SwingFoot::contact_ramp`, klawhs2) — asserted as `passed`
@@ -65,6 +67,7 @@ fn continuity_is_met_at_1_to_7_kmh() {
         (4.0, 2.0),
         (5.0, 1.8),
         (5.0, 2.0),
+        (6.0, 1.8),
         (6.0, 2.0),
         (7.0, 2.0),
         // Since the landing ankle's contact ramp (`SwingFoot::contact_ramp`; main before:

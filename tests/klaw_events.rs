@@ -180,19 +180,22 @@ fn toe_leaves_briskly_and_the_knee_decelerates_into_the_lock() {
     }
 }
 
-/// A steady walk starts mid-motion (klawlead, `generate::LEAD_IN_FRAMES`): frame 0 is at t = 0,
+/// A steady walk starts and ends mid-motion (klawlead, `generate::LEAD_IN_FRAMES`,
+/// `generate::LEAD_OUT_FRAMES`). The start: frame 0 is at t = 0,
 /// `LEAD_IN_FRAMES` frames before the first heel strike, in the landing swing of the last
 /// pre-roll step (`generate::PRE_ROLL`) — the landing foot in the air, the other on the ground —
 /// and no event falls before frame 0. The first step is as steady as the later ones: the times
 /// from its heel strike to its foot flat and heel off and to the trailing foot's meta off and
 /// toe off match the third step's within 3 ms. Before the lead-in frame 0 was the first heel
 /// strike, drawn with one pre-roll step and an extra landing pitch: at 5 km/h × 1.8 m the first
-/// step's foot flat came 10 ms early and the trailing meta off 9 ms late.
+/// step's foot flat came 10 ms early and the trailing meta off 9 ms late. The end: the last
+/// heel strike and the trailing toe off after it are recorded, and the recording runs
+/// `LEAD_OUT_FRAMES` past that toe off (to the frame); it used to end at the last heel strike.
 #[test]
-fn a_steady_walk_starts_mid_motion_before_its_first_heel_strike() {
+fn a_steady_walk_starts_and_ends_mid_motion() {
     use gaitfit::events::{EventKind, Side};
     use gaitfit::generator::skeleton::Landmark;
-    use gaitfit::generator::walking::generate::LEAD_IN_FRAMES;
+    use gaitfit::generator::walking::generate::{LEAD_IN_FRAMES, LEAD_OUT_FRAMES};
     for (kmh, h) in [(1.0, 2.0), (3.0, 1.8), (5.0, 1.8), (7.0, 1.5)] {
         let (_, m, r) = steady_walk(kmh, h, 8);
         let fps = m.fps();
@@ -209,6 +212,26 @@ fn a_steady_walk_starts_mid_motion_before_its_first_heel_strike() {
             hs[0].time_s
         );
         assert!((r.steps[0].start_s - lead).abs() < 1e-9);
+        // The end.
+        let last = &r.steps[r.steps.len() - 1];
+        let t_hs = last.start_s + last.times.step;
+        let t_last = (m.len() - 1) as f64 / fps;
+        assert!((hs[hs.len() - 1].time_s - t_hs).abs() < 1e-9, "{kmh} km/h");
+        let to = m
+            .events
+            .iter()
+            .find(|e| e.kind == EventKind::ToeOff && e.time_s > t_hs)
+            .map_or(f64::NAN, |e| e.time_s);
+        assert!(
+            (to - t_hs - last.times.double_support).abs() < 1e-9,
+            "{kmh} km/h: {to}"
+        );
+        let out = LEAD_OUT_FRAMES as f64 / fps;
+        assert!(
+            t_last > to + out - 1.0 / fps - 1e-9 && t_last <= to + out + 1e-9,
+            "{kmh} km/h: last frame at {t_last} s, toe off at {to} s"
+        );
+        assert!(m.events.iter().all(|e| e.time_s <= t_last + 1.0 / fps));
         // Frame 0: the landing foot in the air above the ground, the other foot on it.
         let (landing, heel) = match hs[0].side {
             Side::Left => (0, Landmark::LHeel),

@@ -45,7 +45,8 @@ pub struct Args {
     #[arg(long, default_value_t = 100.0)]
     pub fps: f64,
     /// Start standing, feet side by side (the first step starts from rest). Without it the walk
-    /// starts steady, recorded from 5 frames before its first heel strike (mid-motion).
+    /// starts steady, recorded from 5 frames before its first heel strike (mid-motion). Without
+    /// --stop it ends 5 frames after the trailing toe off that follows its last heel strike.
     #[arg(long = "from-rest")]
     pub from_rest: bool,
     /// End standing: a last half step, then the trailing foot is brought alongside and the body

@@ -47,7 +47,9 @@ pub struct WalkOptions {
     /// the same clock), in the last pre-roll step's landing swing.
     pub start_from_rest: bool,
     /// End standing: a last half step, then the trailing foot is brought alongside and the body
-    /// comes to rest ([`super::stop`]).
+    /// comes to rest ([`super::stop`]). Otherwise the walk ends mid-motion: one unrecorded step
+    /// is simulated after the last, and the recording ends [`LEAD_OUT_FRAMES`] frames after the
+    /// trailing foot's toe off that follows the last heel strike.
     pub stop: bool,
 }
 
@@ -454,6 +456,25 @@ pub const PRE_ROLL: usize = 2;
 /// check is not met at 60 frames/s with or without a lead-in).
 pub const LEAD_IN_FRAMES: usize = 5;
 
+/// Frames a walk without a stop is recorded past the trailing foot's toe off that follows its
+/// last heel strike (so `t_ds + LEAD_OUT_FRAMES / fps` past that heel strike), drawn from one
+/// unrecorded step simulated after the last (the landing leg's heel rocker, the trailing leg's
+/// double support and first swing frames): the clip ends mid-motion, as it begins
+/// ([`LEAD_IN_FRAMES`]), and the last heel strike is judged like every other.
+///
+/// Why (klawlead, issue 6): the recording used to end at that heel strike, so its last frames
+/// were the landing swing, whose thigh retracts into the contact at the collision-neutral rate
+/// (`SwingSpec::theta3_rate_hs`) — at 6 km/h × 1.8 m the hip's steps 0.004 → 0.010 → 0.021 rad
+/// in the last three frames — against a window of earlier, slower frames only: ratio 5.33 on
+/// the last frame (l_hip, the walk's one offender); the same retraction mid-walk, with the
+/// frames after the contact in the window, measures ≤ 4.5, and a ninth step moved the failure
+/// to the ninth's last frame (r_hip 5.25). The end's window is one-sided the other way, so
+/// whatever *starts* moving within the last 3 frames fails it: ending 5 frames after the heel
+/// strike caught the trailing foot's ball leaving the floor at meta off (r_ball 5.8–12.4 at
+/// 5–7 km/h); after the toe off nothing starts from rest until the stance heel off, and the
+/// swing toe's rise is 5 frames under way (6 km/h × 1.8 m 5.33 → 4.52).
+pub const LEAD_OUT_FRAMES: usize = 5;
+
 /// Generates a walk of the given steps (complete locomotion parameters, one per step).
 pub fn generate_steps(
     steps: &[Locomotion],
@@ -549,9 +570,14 @@ pub fn generate_steps(
     let mut swing_guess = [0.0; 7];
     let mut swing_carry = SwingCarry::default();
     let mut recovery_by_leg = [0.0f64; 2];
+    // Without a stop, one unrecorded step after the last: the lead-out draws its start.
+    let post = if opt.stop { 0 } else { 1 };
     let all: Vec<Locomotion> = std::iter::repeat_n(steps[0], pre)
         .chain(steps.iter().copied())
+        .chain(std::iter::repeat_n(steps[steps.len() - 1], post))
         .collect();
+    // The last recorded heel strike (the end of the last recorded step).
+    let mut t_end = 0.0;
     // Time origin: frame 0 at t = 0, the first recorded heel strike at t = LEAD_IN_FRAMES / fps
     // (at 0 from rest), the pre-roll steps before it.
     let lead = if pre > 0 {
@@ -579,14 +605,19 @@ pub fn generate_steps(
         }
     };
     for (kk, l) in all.iter().enumerate() {
-        let recorded = kk >= pre;
+        let recorded = kk >= pre && kk < pre + steps.len();
         let k = kk.saturating_sub(pre);
         let stage = |what: &str| {
             if recorded {
                 format!("step {k} ({} stance), {what}", stance_side)
-            } else {
+            } else if kk < pre {
                 format!(
                     "steady-state pre-roll step ({} stance), {what}",
+                    stance_side
+                )
+            } else {
+                format!(
+                    "lead-out step after the last ({} stance), {what}",
                     stance_side
                 )
             }
@@ -948,6 +979,9 @@ pub fn generate_steps(
             trail_leg,
             trail_origin: t_global - trailing_clock,
         });
+        if recorded {
+            t_end = t_global + t_step;
+        }
         // Next step.
         ankle_x[idx(swing_side)] = new_ankle_x;
         trailing = stance_leg;
@@ -1013,7 +1047,17 @@ pub fn generate_steps(
         d.swing_foot.theta5_rate_hs = rate.clamp(-MAX_CONTACT_ANKLE_RATE, MAX_CONTACT_ANKLE_RATE);
         d.swing_foot.contact_ramp_weight = contact_ramp_weight(rate);
     }
-    let total = t_global + closing.as_ref().map_or(0.0, |c| c.duration);
+    let total = if post > 0 {
+        t_end
+            + phase_times(
+                steps[steps.len() - 1].step_freq_steps_per_min,
+                &opt.relations,
+            )
+            .double_support
+            + LEAD_OUT_FRAMES as f64 / opt.fps
+    } else {
+        t_global + closing.as_ref().map_or(0.0, |c| c.duration)
+    };
     let motion = assemble(&skeleton, &body, &foot, &data, opt, total, closing.as_ref())?;
     Ok((motion, report))
 }
@@ -1498,9 +1542,10 @@ fn assemble(
         events.push(ev(c.start + c.landing, tr, EventKind::HeelStrike));
         events.push(ev(c.start + c.landing, tr, EventKind::FootFlat));
     }
-    // A steady walk's pre-roll step is drawn only over the lead-in: its events before frame 0
-    // (its heel strike, its trailing leg's toe off) are not in the recording.
-    events.retain(|e| e.time_s >= -1e-9);
+    // A steady walk's pre-roll step is drawn only over the lead-in, the step after the last
+    // over the lead-out: their events outside the recording (the pre-roll's heel strike, its
+    // trailing leg's toe off; the lead-out step's toe off and end) are not in it.
+    events.retain(|e| e.time_s >= -1e-9 && e.time_s <= total + 1e-9);
     events.sort_by(|x, y| x.time_s.total_cmp(&y.time_s));
     events.dedup_by(|x, y| {
         x.kind == y.kind && x.side == y.side && (x.time_s - y.time_s).abs() < 1e-9
