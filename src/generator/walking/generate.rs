@@ -319,13 +319,11 @@ pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.24;
 /// `StanceSpec::drawn_span`: the midstance knee drawn with the 3-D leg's flexion), so the
 /// stance heel stays down at every speed from [`PROJECTED_LOCK_FROUDE_MIN`] on.
 ///
-/// Why not the lower lock above: at 7 km/h × 1.5/1.8 m (Froude 0.73 / 0.67) the heel strikes
-/// improved but the walk's first and last frames got worse (measured, 8 steps: 11.4 → 20.6 at
-/// frame 2, the trailing toe; 6.44 → 9.48 at the last frame, the shoulder), beyond their
-/// guards. Both are the record's edges, where the continuity window is cut: frame 2 is the last
-/// pre-roll stance's toe bend coming to its limit just before toe off (7.8 with that one
-/// stance at the paper's lock), and the shoulder's step at every heel strike grew (7 km/h ×
-/// 1.8 m, frame 282: 0.0072 → 0.0107 rad), hidden inside the walk by the larger steps after it.
+/// Why not the lower lock above: its lower hip makes the arms jolt harder at heel strike
+/// (the shoulder's step at 7 km/h × 1.8 m, frame 287 before the lead-out: 0.0072 → 0.0107
+/// rad). Measured (8 steps, with the lead-in and lead-out frames): 7 km/h ×
+/// 1.5/1.8 m 5.95/4.01 → 6.17/4.45, the worst frame at a shoulder in all four; before the
+/// lead-out, 7 km/h × 1.8 m's last frame went 6.48 → 9.48.
 pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
 
 /// Whether a stance at `speed` m/s of a body with unloaded leg `l1` locks at the sagittal
