@@ -751,7 +751,8 @@ pub fn generate_steps(
         // `FIRST_TOE_OFF_THIGH` of its heel-strike angle (see there).
         // So does a trailing leg whose stance was slower than the step it toes off in (a speed
         // change in the schedule, `speeds_up`): see there.
-        if ((opt.start_from_rest && kk < 2) || speeds_up(&all, kk))
+        if ((opt.start_from_rest && kk < 2)
+            || (speeds_up(&all, kk) && trailing.period == FootPeriod::HeelOff))
             && trailing.period != FootPeriod::MetaOff
         {
             let (hp, hz) = swing_hip3(0.0);
@@ -1083,7 +1084,10 @@ pub fn generate_steps(
 /// (the swing foot's θ5 starts at rest) spikes. Starting the blend later (only as early as a
 /// u² ramp at `TOE_OFF_KNEE_RATE` needs) was the same or worse (1 → 2 km/h × 2.0 m
 /// 4.58 → 4.73). Slower steps are left alone: 5 → 3 km/h's trailing leg enters meta-off within
-/// 5 ms of the same time either way.
+/// 5 ms of the same time either way. Only a trailing foot already in heel off is moved on to
+/// meta off: a foot still flat (1 km/h stance legs of a 2.0 m body, flat until late) snapped
+/// onto its toe tip, 22 mm in one frame (1 → 3 and 1 → 5 km/h × 2.0 m from standing: 46.4 and
+/// 22.8 → 4.58), and goes through heel off as the rule has it.
 fn speeds_up(all: &[Locomotion], kk: usize) -> bool {
     kk > 0 && all[kk].speed_m_per_s > all[kk - 1].speed_m_per_s + 1e-9
 }
