@@ -132,6 +132,11 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     };
     let (motion, report) = generate_walk(&schedule, &opts)?;
     crate::export::motion::write(&motion, &args.output)?;
+    // What the generator changed or chose on its own (a ramped speed change, the start, the
+    // stop, recoveries) is said, not only stored in the motion's metadata.
+    for note in &report.notes {
+        eprintln!("gaitfit: note: {note}");
+    }
     let it = report.total_iterations();
     let n = report.steps.len().max(1);
     eprintln!(
