@@ -437,6 +437,18 @@ fn a_speed_up_from_a_flat_trailing_foot_stays_continuous() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// A slow step whose heel rocker finds no landing (1 → 1.5 km/h × 2.0 m from standing, with a
+/// stop: the first 1.5 km/h stance, whose hip never comes within the straight leg's reach of the
+/// flat ankle) is landed by the straight leg with the knee straight; the flat and heel-off rules
+/// asked for the soft leg length in that same frame (foot flat and heel off at once: the knee
+/// 0.112 rad in one frame, ratio 111.9). The knee now eases up from straight
+/// (`virtual_leg::KNEE_LAND_EASE`): measured 4.58 (frame 484, l_ankle), k = 5 met.
+#[test]
+fn a_straight_leg_landing_eases_the_knee() {
+    let (w, r) = worst(&[(1.0, 4), (1.5, 4)], 2.0, true);
+    assert!(w <= 5.0, "1 -> 1.5 km/h x 2.0 m: {r}");
+}
+
 /// A 1 → 7 km/h schedule (4 steps each, from standing, with a stop) is ramped by the default
 /// `max_speed_change_m_per_s` = 0.5 m/s per step (1 → 2.5 → 4 → 5.5 → 7 km/h) and stays within
 /// the bounds measured with it (× 1.25). In one step (the limit off) the same walk scored 128.9 /

@@ -41,6 +41,16 @@ pub const KNEE_SOFT: f64 = 0.0015;
 /// a little earlier, so the ankle stays in reach), C¹ through its peak and its return to rest.
 pub const KNEE_EASE: f64 = 0.015;
 
+/// Time constant of the knee's ease from a straight-leg landing, s: where no heel rocker could be
+/// planned (slow walks whose hip never comes within the straight leg's reach of the flat ankle)
+/// the straight leg lands the foot with the knee straight and at rest, and the flat and heel-off
+/// rules then asked for the soft leg length `l − σ` in the same frame — a knee flexion of
+/// ≈ 0.11 rad in one frame (foot flat and heel off in one frame; continuity 111.9 at 1 → 1.5
+/// km/h × 2.0 m). The knee instead leaves straight at rest as a critically damped second-order
+/// system with this time constant, from below as well as from above the rule's knee (a
+/// straighter knee only lets the foot roll a little later; it is always in reach).
+pub const KNEE_LAND_EASE: f64 = 0.03;
+
 /// The knee is eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
 /// margin ([`VirtualLeg::knee_soft`]) below this, m: a landing within 0.33 mm of the straight
 /// leg. Measured (8 steps): 1 km/h lands at 0.04–0.30 mm, 2 km/h at 0.41–0.67 mm after its
@@ -166,6 +176,10 @@ pub struct VirtualLeg {
     /// rate at the last flat / heel-off sample, and the rule's knee then. `None` before the
     /// foot is flat.
     pub knee_ease: Option<[f64; 4]>,
+    /// Whether the straight leg landed the foot (no planned heel rocker): the knee then eases
+    /// from straight toward the flat and heel-off rules' knee from either side (see
+    /// [`KNEE_LAND_EASE`]), not only from the more flexed side.
+    pub ease_from_landing: bool,
     /// Longest hip–ankle span the flat and heel-off rules draw, m: `l3 + l4` (the paper's
     /// straight knee), shorter where the stance leg locked short of `l1` at speed
     /// (`StanceSpec::drawn_span`): the knee then keeps that flexion through midstance and heel
@@ -449,6 +463,7 @@ impl VirtualLeg {
             knee_soft: KNEE_SOFT,
             slow_knee_start: true,
             knee_ease: None,
+            ease_from_landing: false,
             span_max: body.l3 + body.l4,
         }
     }
@@ -718,23 +733,30 @@ impl VirtualLeg {
         let (k, kd) = match self.knee_ease {
             Some([t0, k0, kd0, kr0]) if t > t0 => {
                 let h = t - t0;
-                let w = 1.0 / KNEE_EASE;
+                let w = if self.ease_from_landing {
+                    1.0 / KNEE_LAND_EASE
+                } else {
+                    1.0 / KNEE_EASE
+                };
                 let e = k0 - k_rule;
                 let c = kd0 + w * e;
                 let decay = (-w * h).exp();
                 let k1 = k_rule + (e + c * h) * decay;
                 let kd1 = (kd0 - w * c * h) * decay;
-                if k1 <= k_rule {
+                if k1 <= k_rule && !self.ease_from_landing {
                     (k_rule, (k_rule - kr0) / h)
                 } else {
                     (k1, kd1)
                 }
             }
+            Some([_, k0, kd0, _]) if self.ease_from_landing => (k0, kd0),
             Some([_, k0, kd0, _]) => (k0.max(k_rule), kd0),
             None => (k_rule, 0.0),
         };
         self.knee_ease = Some([t, k, kd, k_rule]);
-        if k > k_rule {
+        if self.ease_from_landing {
+            span_for(l3, l4, k)
+        } else if k > k_rule {
             span_for(l3, l4, k).min(d_rule)
         } else {
             d_rule
@@ -765,6 +787,12 @@ impl VirtualLeg {
                 self.period = FootPeriod::Flat;
                 self.rho = 0.0;
                 self.transitions[0] = Some(t);
+                // The straight leg lands the foot (no planned rocker: slow walks, whose hip
+                // never comes within the straight leg's reach of the flat ankle) with the knee
+                // straight and at rest; the flat and heel-off rules' knee is eased up from there
+                // (see `KNEE_LAND_EASE`), not taken in this frame.
+                self.knee_ease = Some([t, 0.0, 0.0, 0.0]);
+                self.ease_from_landing = true;
             } else {
                 let a = -1.2;
                 // Out of reach even steeply pitched: hold the roll (pitching the foot up to
@@ -799,7 +827,7 @@ impl VirtualLeg {
                 d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
             };
             // Only where the planned rocker landed nearly straight (see `KNEE_EASE_SOFT`).
-            let d_t = if self.knee_soft < KNEE_EASE_SOFT {
+            let d_t = if self.knee_soft < KNEE_EASE_SOFT || self.ease_from_landing {
                 self.eased_span(t, d_t)
             } else {
                 d_t
