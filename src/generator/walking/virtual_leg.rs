@@ -74,7 +74,8 @@ pub const KNEE_EASE_SOFT: f64 = 0.00033;
 /// 2 km/h 6.29/6.77/6.83 → 4.52/6.35/5.22, 5 km/h 1.5 m 12.1 (frame 0) → 9.8; 7 km/h 1.8 m
 /// 10.57 → 10.75; the other walks unchanged. A landing that would switch the knee ease
 /// ([`KNEE_EASE_SOFT`]) on or off against the shortest's is not taken (1 km/h × 1.5 m 4.6 →
-/// 6.9 otherwise).
+/// 6.9 otherwise), unless the kept one's knee leaves heel strike at ≥ 2 × its mean rate (1 → 7
+/// km/h × 2.0 m 26.85 → 4.58 with the exception).
 pub const ROCKER_SCAN: usize = 4;
 
 /// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow):
@@ -620,6 +621,7 @@ impl VirtualLeg {
         let mut duration = min_duration;
         let mut best: Option<(f64, HeelRocker, f64, f64)> = None;
         let mut left = usize::MAX;
+        let mut best_fast = false;
         for _ in 0..30 {
             let kt = samples.partition_point(|s| s.0 < t_first + duration);
             if left == 0 || kt + 1 >= samples.len() {
@@ -710,7 +712,13 @@ impl VirtualLeg {
             let same = best
                 .as_ref()
                 .is_none_or(|b| (b.3.max(0.5 * (l1 - b.2)) < KNEE_EASE_SOFT) == eased);
-            if same && best.as_ref().is_none_or(|b| cost < b.0) {
+            // Unless the kept landing's knee leaves heel strike at twice its mean rate or faster
+            // (a knee at rest in swing then flexes ≈ 0.03 rad in the first frame: 1 → 7 km/h ×
+            // 2.0 m's 4 km/h step, whose shortest landing is eased and the gentler later ones not;
+            // ratio 26.85 → 4.58 without the rule there).
+            let fast = best.is_some() && best_fast;
+            if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
+                best_fast = f >= 2.0;
                 best = Some((cost, HeelRocker { end, table }, landing, soft));
             }
             left = left.min(scan + 1) - 1;
