@@ -449,6 +449,16 @@ fn a_straight_leg_landing_eases_the_knee() {
     assert!(w <= 5.0, "1 -> 1.5 km/h x 2.0 m: {r}");
 }
 
+/// Slowing 7 → 1 km/h (4 steps each, from standing, with a stop; ramped 7 → 5.5 → 4 → 2.5 →
+/// 1 km/h) at 2.0 m: the slow steps' ankle leaves the ground high and the swing1 ankle curve's
+/// far flank was as steep as the ankle's reach about the knee (73.5 at frame 498, l_knee, before
+/// `LIFT_OVER_TOE_OFF` in `swing.rs`; measured 4.62 after).
+#[test]
+fn slowing_from_7_to_1_kmh_keeps_the_swing_ankle_on_its_curve() {
+    let (w, r) = worst(&[(7.0, 4), (1.0, 4)], 2.0, true);
+    assert!(w <= 5.0, "7 -> 1 km/h x 2.0 m: {r}");
+}
+
 /// A 1 → 7 km/h schedule (4 steps each, from standing, with a stop) is ramped by the default
 /// `max_speed_change_m_per_s` = 0.5 m/s per step (1 → 2.5 → 4 → 5.5 → 7 km/h) and stays within
 /// the bounds measured with it (× 1.25). In one step (the limit off) the same walk scored 128.9 /

@@ -436,6 +436,17 @@ const LIFT_PER_TRAVEL: f64 = 0.25;
 /// swing1 clearance rounds still raise the curve where the toe needs it.
 const LIFT_SPEED_MIN: f64 = 3.0 / 3.6;
 
+/// Fraction of the lift added above the toe-off ankle height where that is above the
+/// landing height plus the lift (the paper lifts from `max(a0, a_min)`, §4.3 leaves the case open).
+///
+/// Why: slowing 7 → 1 km/h, the slow steps leave the ground with the ankle 8 cm above its
+/// heel-strike height on a short travel (D = 0.29 m); the full lift on top made the curve's far
+/// flank as steep as the circle the ankle can reach about the knee, and the slaved knee lost its
+/// root (a one-frame 0.4 m ankle jump: `REST=1 STOP=1 kjumps 7x4,1x4 2.0 5` 73.5 → 4.62).
+/// 0 (no lift above a0) made the quartic dip below a0 after toe-off (53.2 at toe-off); 0.5
+/// left 5.16. Steady walks: 2 km/h 3.5–4.5 → 3.2–3.4, others unchanged.
+const LIFT_OVER_TOE_OFF: f64 = 0.25;
+
 impl SwingSpec<'_> {
     /// The kinematic swing foot of this swing.
     pub fn swing_foot(&self) -> SwingFoot {
@@ -560,7 +571,10 @@ impl SwingSpec<'_> {
         }
         let a_min = a1[1] + extra_lift;
         let lift = (self.ankle_lift / speed.max(LIFT_SPEED_MIN)).min(LIFT_PER_TRAVEL * d);
-        let a_max = a0[1].max(a_min) + lift;
+        // The peak clears the landing height by the full lift, but an ankle that leaves the
+        // ground already higher (a slow step after fast ones) is lifted only LIFT_OVER_TOE_OFF
+        // of it: see there.
+        let a_max = (a0[1] + LIFT_OVER_TOE_OFF * lift).max(a_min + lift);
         AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
             .ok_or_else(|| "ankle curve is singular".to_string())
     }
