@@ -313,49 +313,24 @@ fn the_cli_stop_ends_with_the_trailing_foot_landing() {
 #[test]
 fn the_cli_says_when_it_ramps_a_schedule() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("jump.csv"),
-        "steps,speed_km_per_h\n4,1\n4,7\n",
-    )
-    .unwrap();
-    let out = assert_cmd::Command::cargo_bin("gaitfit")
-        .unwrap()
-        .current_dir(dir.path())
-        .args([
-            "generate",
-            "walk",
-            "--schedule",
-            "jump.csv",
-            "-o",
-            "walk.csv",
-        ])
-        .assert()
-        .success();
-    let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    // `gaitfit generate walk --schedule <name>` on a schedule file `csv`: its stderr.
+    let stderr_of = |name: &str, csv: &str| {
+        std::fs::write(dir.path().join(name), csv).unwrap();
+        let out = assert_cmd::Command::cargo_bin("gaitfit")
+            .unwrap()
+            .current_dir(dir.path())
+            .args(["generate", "walk", "--schedule", name, "-o", "walk.csv"])
+            .assert()
+            .success();
+        String::from_utf8_lossy(&out.get_output().stderr).to_string()
+    };
+    let err = stderr_of("jump.csv", "steps,speed_km_per_h\n4,1\n4,7\n");
     assert!(
         err.contains("note:") && err.contains("max_speed_change_m_per_s"),
         "{err}"
     );
     // Within the limit: no ramp note.
-    std::fs::write(
-        dir.path().join("small.csv"),
-        "steps,speed_km_per_h\n4,3\n4,4\n",
-    )
-    .unwrap();
-    let out = assert_cmd::Command::cargo_bin("gaitfit")
-        .unwrap()
-        .current_dir(dir.path())
-        .args([
-            "generate",
-            "walk",
-            "--schedule",
-            "small.csv",
-            "-o",
-            "walk.csv",
-        ])
-        .assert()
-        .success();
-    let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+    let err = stderr_of("small.csv", "steps,speed_km_per_h\n4,3\n4,4\n");
     assert!(!err.contains("max_speed_change_m_per_s"), "{err}");
 }
 
