@@ -5,7 +5,8 @@
 //!   the heel-strike value; the knee is locked in the dynamics (eq. 5 with correction 4) and its
 //!   angle is set, at every evaluation, so that the ankle lies on the 4th-order polynomial `P`
 //!   through the five conditions of §4.3;
-//! - *swing2* (t1 → t2): hip held by a spring–damper about the heel-strike angle, knee torque
+//! - *swing2* (t1 → t2): hip held by a spring–damper about the heel-strike angle (here, with the
+//!   knee brake, about an angle leading it by part of swing3's retraction, [`SWING3_LEAD`]), knee torque
 //!   `F_θ4 = B·e^{−(t−t1)/τ}`, `B` found so that the knee is straight (`θ4 = 0`) exactly at t2 —
 //!   here plus a terminal knee brake `E·uⁿ` (with a hip-extension share, the hamstrings), `B`
 //!   and `E` found together so that the knee is also at rest at t2 ([`KNEE_BRAKE_POWER`]: the
@@ -416,6 +417,26 @@ pub const KNEE_BRAKE_HIP_RATIO: f64 = 2.0;
 /// 0.9 left 1.5 km/h × 1.6 m's double support 42 ms long).
 pub const RECOVERY_END: f64 = 0.85;
 
+/// Fraction of swing3's landing retraction `θ̇3_hs·(t_swing − t2)` ([`SwingSpec::theta3_rate_hs`])
+/// by which swing2's hip set point leads the heel-strike angle at t2 (ramped in over swing2 with
+/// a smoothstep), when the knee is braked: the thigh reaches the knee lock ahead of its landing
+/// angle and retracts into the contact, as a human thigh does in terminal swing.
+///
+/// Why: swing3 takes the thigh from its state at t2 to `θ3_hs` at `θ̇3_hs`. With the set point at
+/// `θ3_hs` the braked thigh came to t2 only 0.04–0.07 rad ahead of it (behind it at 7 km/h), yet
+/// already retracting at 0.5–0.8 rad/s: less way than a retraction between those two rates
+/// covers, so swing3's torque stopped the thigh and retracted it again (at 7 km/h swung it
+/// forward first). The swing heel slowed to 0.19–0.26 m/s about 1 cm above the floor at t2 and
+/// sped up again by 0.2–1.1 m/s before contact (a stall 9 frames before heel strike at
+/// 1.5 km/h; gaitfit's foot-speed events see the heel through it). A thigh at rest at t2 that
+/// reaches `θ̇3_hs` at a constant acceleration retracts `½·θ̇3_hs·T3`; the spring–damper lags
+/// its ramped set point, hence more. Measured (8 steps, 1–7 km/h × 1.5/1.8/2.0 m, the heel's
+/// forward speed from its late-swing peak to contact): it rose again by up to 0.19–1.08 m/s per
+/// walk, now by at most 0.12 m/s (0 in 22 of 24 walks); 1/2 as a constant offset left up to
+/// 0.13 m/s and raised 7 km/h × 2.0 m's worst continuity ratio 3.61 → 4.28 (an elbow at heel
+/// strike), 3/4 ramped leaves it at 3.80.
+pub const SWING3_LEAD: f64 = 0.75;
+
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
 
@@ -681,10 +702,19 @@ impl SwingSpec<'_> {
         let tau = self.tau[1];
         let th3_hs = self.theta3_hs;
         let end = if self.knee_brake { RECOVERY_END } else { 1.0 };
+        // The set point leads the heel-strike angle by part of swing3's retraction (see
+        // SWING3_LEAD), ramped in over swing2.
+        let lead = if self.knee_brake {
+            SWING3_LEAD * self.theta3_rate_hs * (self.times[3] - t2)
+        } else {
+            0.0
+        };
         let f = |t: f64, y: &[f64; 4]| {
             let hip = (self.hip)(t);
             let u = (t - t1) / (t2 - t1);
-            let set = th3_hs - pa * (std::f64::consts::PI * (u / end).min(1.0)).sin();
+            let set = th3_hs
+                - lead * smoothstep(u)
+                - pa * (std::f64::consts::PI * (u / end).min(1.0)).sin();
             // The knee brake (hamstrings): flexes the knee and extends the hip.
             let brake = be[1] * u.powi(KNEE_BRAKE_POWER);
             let f3 = -k3 * (y[0] - set) - c3 * y[2] + KNEE_BRAKE_HIP_RATIO * brake;
