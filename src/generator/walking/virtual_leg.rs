@@ -4,7 +4,9 @@
 //! the infinitely many:
 //! - *normal period*: after heel strike the foot rotates about the heel, with the knee straight,
 //!   until it is flat (the leg's reach decides: while the flat foot's ankle is out of reach of the
-//!   extended leg the foot stays pitched up); then the foot stays flat and the knee takes up the
+//!   extended leg the foot stays pitched up, and if the hip passes its closest approach with the
+//!   flat ankle still just out of reach — a stance leg locked longer than `l1` — the foot rocks
+//!   over flat onto its ball, straight into heel off); then the foot stays flat and the knee takes up the
 //!   telescopic leg's shortening, until the ankle's dorsiflexion θ5 reaches its limit or the
 //!   foot has to roll for the leg to reach;
 //! - *heel-off period*: the foot rolls about the metatarsal joint (toes flat) just enough to keep
@@ -75,7 +77,8 @@ pub const KNEE_EASE_SOFT: f64 = 0.00033;
 /// 10.57 → 10.75; the other walks unchanged. A landing that would switch the knee ease
 /// ([`KNEE_EASE_SOFT`]) on or off against the shortest's is not taken (1 km/h × 1.5 m 4.6 →
 /// 6.9 otherwise), unless the kept one's knee leaves heel strike at ≥ 2 × its mean rate (1 → 7
-/// km/h × 2.0 m 26.85 → 4.58 with the exception).
+/// km/h × 2.0 m 26.85 → 4.58 with the exception) or flexes, straightens and flexes again inside
+/// the rocker (the first slower step of a slow-down: 3 → 1 km/h × 1.8 m 10.6 → 4.2).
 pub const ROCKER_SCAN: usize = 4;
 
 /// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow):
@@ -187,6 +190,11 @@ pub struct VirtualLeg {
     /// off, and the heel rises as soon as the hip is farther than this from the flat ankle. The
     /// heel rocker's landing is planned against it too (the flat foot must be within it).
     pub span_max: f64,
+    /// How far the flat foot's ankle was beyond the straight leg's reach at the last sample of a
+    /// heel rocker without a plan, m (`None` before the first): while it shrinks the foot rolls
+    /// about the heel toward flat; once it grows again the foot rocks over (see
+    /// [`VirtualLeg::advance`]).
+    pub rocker_gap: Option<f64>,
 }
 
 /// A planned heel rocker: the foot's roll at the leg's samples from heel strike (`−pitch`) to
@@ -227,6 +235,22 @@ fn knee_for(l3: f64, l4: f64, d: f64) -> f64 {
         - ((l3 * l3 + l4 * l4 - dc * dc) / (2.0 * l3 * l4))
             .clamp(-1.0, 1.0)
             .acos()
+}
+
+/// Whether the heel rocker's knee Hermite (from straight at rate `r0` to `k_end` at rate `r1`
+/// over `big_t`) flexes, straightens and flexes again: its rate, a quadratic in time, turns
+/// negative inside the rocker and is positive at its end.
+fn knee_dips(k_end: f64, big_t: f64, r0: f64, r1: f64) -> bool {
+    // The rate in u = t/T: a·u² + b·u + c.
+    let m = k_end / big_t;
+    let a = -6.0 * m + 3.0 * (r0 + r1);
+    let b = 6.0 * m - 4.0 * r0 - 2.0 * r1;
+    let c = r0;
+    if r1 <= 0.0 || a <= 0.0 {
+        return false;
+    }
+    let u = -b / (2.0 * a);
+    u > 0.0 && u < 1.0 && c - b * b / (4.0 * a) < 0.0
 }
 
 /// Length of a two-link leg with knee flexion `knee`, m.
@@ -466,6 +490,7 @@ impl VirtualLeg {
             knee_ease: None,
             ease_from_landing: false,
             span_max: body.l3 + body.l4,
+            rocker_gap: None,
         }
     }
 
@@ -715,10 +740,15 @@ impl VirtualLeg {
             // Unless the kept landing's knee leaves heel strike at twice its mean rate or faster
             // (a knee at rest in swing then flexes ≈ 0.03 rad in the first frame: 1 → 7 km/h ×
             // 2.0 m's 4 km/h step, whose shortest landing is eased and the gentler later ones not;
-            // ratio 26.85 → 4.58 without the rule there).
+            // ratio 26.85 → 4.58 without the rule there), or its knee flexes, straightens and
+            // flexes again (`knee_dips`: the first slower stance of a slow-down, which lands from
+            // the faster step's steeper heel-strike pitch; its shortest, eased landing must meet
+            // the flat foot's knee at 5 × its mean rate, 5–9 rad/s, and the knee flexed 0.012 rad
+            // in the first frame, straightened and surged 0.2 rad at foot flat: 3 → 1 km/h ×
+            // 1.8 m 10.6, 2 → 1 km/h × 1.8 m 7.9, 1.5 → 1 km/h × 2.0 m 6.2 → 4.2, 4.0, 4.8).
             let fast = best.is_some() && best_fast;
             if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
-                best_fast = f >= 2.0;
+                best_fast = f >= 2.0 || knee_dips(k_end, big_t, r0, k_rate);
                 best = Some((cost, HeelRocker { end, table }, landing, soft));
             }
             left = left.min(scan + 1) - 1;
@@ -791,7 +821,18 @@ impl VirtualLeg {
         if self.period == FootPeriod::HeelRocker {
             // Largest ρ ≤ 0 within reach of the straight leg: reach(ρ) increases with ρ here.
             let g = |r: f64| reach(self, r);
-            if g(0.0) <= 0.0 {
+            let gap = g(0.0);
+            // The hip has passed its closest approach to the flat ankle, which stayed just out of
+            // the straight leg's reach, and the held roll is out of reach too: the foot rocks
+            // through flat onto its ball (foot flat and heel off at once), where the heel-off
+            // rule keeps the ankle within reach, instead of hovering pitched a little up and
+            // being lifted off the ground by the straight leg. Why: a stance leg that locked
+            // above `l1` (the first faster step after a slow one: the ramped 1 → 7 km/h × 2.0 m
+            // walk's 2.5 km/h stance, 0.11 mm short of flat at its closest, then 2.5 mm beyond
+            // reach through midstance) hovered its foot 2–3 mm up and left the ground flat,
+            // with no foot-flat or heel-off event.
+            let rocks_over = self.rocker_gap.is_some_and(|last| gap > last) && g(self.rho) > 0.0;
+            if gap <= 0.0 || rocks_over {
                 self.period = FootPeriod::Flat;
                 self.rho = 0.0;
                 self.transitions[0] = Some(t);
@@ -808,6 +849,7 @@ impl VirtualLeg {
                 if g(a) <= 0.0 {
                     self.rho = root_nonpositive_side(&g, 0.0, a).max(self.rho);
                 }
+                self.rocker_gap = Some(gap);
                 let mut p = self.pose_at(hip, dz, self.rho);
                 p.period = self.period;
                 return p;
@@ -952,6 +994,33 @@ mod tests {
             .map(|w| ((w[2] - 2.0 * w[1] + w[0]) / 0.002f64.powi(2)).abs())
             .fold(0.0, f64::max);
         (peak, end)
+    }
+
+    #[test]
+    fn a_knee_hermite_dips_only_when_its_rate_turns_negative_inside() {
+        // The 3 -> 1 km/h x 1.8 m slow-down's first 1 km/h landing (T 58 ms, leaving at 1.5 x
+        // and meeting the flat knee at 5.3 x the mean rate): it flexes, straightens, flexes.
+        let (k, t) = (0.0965, 0.058);
+        assert!(knee_dips(k, t, 1.5 * k / t, 8.885));
+        // A steady 1 km/h x 1.5 m landing (from 0.25 x, meeting it at 3.3 x): monotone.
+        let (k, t) = (0.091, 0.0699);
+        assert!(!knee_dips(k, t, 0.25 * k / t, 4.358));
+        // A knee straightening at the landing is not a dip, nor a plain smoothstep.
+        assert!(!knee_dips(0.073, 0.11, 0.073 / 0.11, -1.4));
+        assert!(!knee_dips(0.1, 0.1, 0.0, 0.0));
+        // Check against the sampled rate.
+        for (r0, r1) in [(0.0, 2.9), (0.0, 3.1), (1.0, 4.0), (0.5, 4.3), (2.0, 6.0)] {
+            let (k, t) = (0.1, 0.1);
+            let m = k / t;
+            let sampled = (1..1000).any(|i| {
+                let u = i as f64 / 1000.0;
+                k * (6.0 * u - 6.0 * u * u) / t
+                    + r0 * m * ((3.0 * u - 4.0) * u + 1.0)
+                    + r1 * m * (3.0 * u - 2.0) * u
+                    < 0.0
+            });
+            assert_eq!(knee_dips(k, t, r0 * m, r1 * m), sampled, "{r0} {r1}");
+        }
     }
 
     #[test]
