@@ -68,11 +68,9 @@ pub struct SwingSpec<'a> {
     /// [`SwingSpec::theta3_rate_hs`]; otherwise the paper's swing2 and swing3 (one torque each,
     /// the knee locks at whatever rate it reaches).
     ///
-    /// `generate` keeps the paper's swing for the first swing from standing (braked, its
-    /// start at 5 km/h × 1.5 m measured 13.6 against 5.6) and the last two before a stop (the
-    /// stop was tuned on them: braked, the half step's heel sank 0.5–1.3 mm into the ground at
-    /// 3 and 5 km/h, and with only the half step kept the stop's landing knee at 1 km/h ×
-    /// 1.5 m measured 4.8 against 2.3); every other swing is braked.
+    /// `generate` brakes every swing; the first from standing since klawstart2 (with its
+    /// swing1 end and ankle lift chosen for a hip starting from rest, see `generate`'s
+    /// `first_swing_choices`).
     pub knee_brake: bool,
     /// Thigh rate θ̇3 at heel strike, rad/s, which swing3 meets (with a second torque, a ramp
     /// `D·(t − t2)/(t_swing − t2)`) when `knee_brake` is set: `generate` passes the rate for
