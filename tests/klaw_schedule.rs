@@ -472,7 +472,7 @@ fn swing_ankle_peak_speed_from_standing() {
 /// `swing_ankle_peak_speed_from_standing`; a person's first swing, gait initiation, measures
 /// ≈ 1.6–2.2) at 1–7 km/h × 1.5/1.8/2.0 m.
 ///
-/// Met since klawstart2 (`generate::FIRST_SWING_PEAK_OVER_MEAN`; measured 1.97–2.43, worst 1 km/h
+/// Met since klawstart2 (`generate::FIRST_SWING_PEAK_OVER_MEAN`; measured 1.97–2.39, worst 1 km/h
 /// × 2.0 m). Before: 1 km/h 3.66/3.85/3.83, 2 km/h 3.39/3.47/3.52, 3 km/h 3.02/3.20/3.18,
 /// 4 km/h 4.02/4.36/5.87, 5 km/h 2.75/2.56/2.44, 6 km/h 1.90/1.96/2.03, 7 km/h 1.86/1.95/2.00
 /// (1.5/1.8/2.0 m): at the paper's end of swing1 the hip, starting from rest, has barely moved,

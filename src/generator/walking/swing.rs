@@ -97,7 +97,8 @@ pub struct SwingSpec<'a> {
 /// clearance during swing" is therefore also honoured kinematically, as a person does: the ankle
 /// dorsiflexes beyond the interpolated value just enough for the toe and ball to stay
 /// `clearance` above the ground (the clearance ramps in from 0 at toe-off over the first 30 % of
-/// swing1, while the toe is leaving the ground), up to the dorsiflexion limit `theta5_max`. The
+/// swing1, at least 15 % of the swing, [`SwingFoot::clearance_ramp`], while the toe is leaving
+/// the ground), up to the dorsiflexion limit `theta5_max`. The
 /// dynamic recovery of swing2 still handles what this cannot (the heel).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SwingFoot {
@@ -203,10 +204,10 @@ impl SwingFoot {
     /// ratios 5–7.5 on the ankle a third of the way into the swing at 7 km/h). The smooth
     /// maximum is never below either, so the foot clears at least as before.
     pub fn pose(&self, t: f64, ankle: [f64; 2], shank: f64) -> (f64, f64) {
-        let [t0, t1, t2, t3] = self.times;
+        let [t0, _, t2, t3] = self.times;
         let (th5, th6) = self.theta56(t);
         let phi_i = th5 - FRAC_PI_2 - shank;
-        let need = self.clearance * smoothstep((t - t0) / (0.3 * (t1 - t0)));
+        let need = self.clearance * smoothstep((t - t0) / self.clearance_ramp());
         let phi_max = self.theta5_max - FRAC_PI_2 - shank;
         if phi_i >= phi_max {
             return (phi_i, th6);
@@ -232,10 +233,23 @@ impl SwingFoot {
         }
         // The width ramps in with the clearance (at toe-off the toe is on the ground, where the
         // two pitches agree: a full width would pitch the foot up at once).
-        let ramp = smoothstep((t - t0) / (0.3 * (t1 - t0)));
+        let ramp = smoothstep((t - t0) / self.clearance_ramp());
         let e = CLEARANCE_SOFT * ramp * (1.0 - smoothstep((t - t2) / (t3 - t2)));
         let phi = 0.5 * (phi_i + phi_c + ((phi_i - phi_c).powi(2) + e * e).sqrt());
         (phi.min(phi_max), th6)
+    }
+
+    /// How long after toe off the toe clearance takes to ramp in, s: 30 % of swing1, but at
+    /// least [`CLEARANCE_RAMP_MIN`] of the swing.
+    ///
+    /// Why the floor: the first swing from standing may end swing1 at 25–30 % of the swing
+    /// (`generate`'s `first_swing_choices`), and 30 % of that lifted the toe to its clearance in
+    /// 4 frames, then held it (2.5 km/h × 1.55 m from standing: 6.24 at the toe, 2 km/h × 1.8 m
+    /// 3.74). Every swing whose swing1 ends at half the swing or later (the paper's default, the
+    /// stop's) keeps its ramp.
+    pub fn clearance_ramp(&self) -> f64 {
+        let [t0, t1, _, t3] = self.times;
+        (0.3 * (t1 - t0)).max(CLEARANCE_RAMP_MIN * (t3 - t0))
     }
 
     /// Foot sole points at `t` (see [`SwingFoot::pose`]).
@@ -244,6 +258,10 @@ impl SwingFoot {
         self.foot.points(ankle, phi, th6)
     }
 }
+
+/// Least time over which the swing toe's clearance ramps in after toe off, as a fraction of the
+/// swing (see [`SwingFoot::clearance_ramp`]): 30 % of a swing1 that ends at half the swing.
+pub const CLEARANCE_RAMP_MIN: f64 = 0.15;
 
 /// Width of the swing foot's smooth maximum between its interpolated pitch and the pitch the
 /// toe clearance needs, rad (see [`SwingFoot::pose`]): about 1.4° of extra dorsiflexion where
@@ -870,9 +888,9 @@ impl SwingSpec<'_> {
             it1 += s1.iterations;
             let mut track = Track::default();
             let y1 = self.swing1(start, &curve, s1.x[0], tau1, h, Some(&mut track));
-            // The toe is leaving the ground at toe-off: the clearance applies from 30 % of
-            // swing1 on; before that the foot must merely stay above the ground.
-            let t_check = t0 + 0.3 * (t1 - t0);
+            // The toe is leaving the ground at toe-off: the clearance applies once it has ramped
+            // in (`SwingFoot::clearance_ramp`); before that the foot must merely stay above the ground.
+            let t_check = t0 + self.swing_foot().clearance_ramp();
             let mut deficit: f64 = 0.0;
             for n in track.nodes.iter().filter(|n| n.t > t0) {
                 let low = self.foot_points(n.t, &n.q).lowest();
@@ -1056,8 +1074,8 @@ impl SwingSpec<'_> {
             padded(s)
         };
         let y3 = self.swing3(y3_0, s3.x, h, Some(&mut track));
-        // Clearance over the swing from 30 % of swing1 on (the toe is leaving before that).
-        let t_check = t0 + 0.3 * (t1 - t0);
+        // Clearance over the swing once it has ramped in (the toe is leaving before that).
+        let t_check = t0 + self.swing_foot().clearance_ramp();
         let min_clearance = track
             .nodes
             .iter()
