@@ -294,7 +294,7 @@ impl AnkleCurve {
     /// Fits the five conditions `y(0) = a0, y(C) = a_max, y'(C) = 0, y(D) = a_min, y'(D) = 0`
     /// with `C = 0.3·D` (§4.3).
     pub fn fit(x0: f64, d: f64, a0: f64, a_max: f64, a_min: f64) -> Option<AnkleCurve> {
-        let c = 0.3 * d;
+        let c = PEAK_AT * d;
         let m = nalgebra::Matrix4::new(
             c,
             c * c,
@@ -321,6 +321,45 @@ impl AnkleCurve {
             d,
             heights: [a0, a_max, a_min],
         })
+    }
+
+    /// The quartic that leaves `a0` level and peaks at `C = γ·D`: `y(0) = a0, y'(0) = 0,
+    /// y'(C) = 0, y(D) = a_min, y'(D) = 0` (`γ` = `peak` in `[0, 0.3]`; its peak height follows).
+    /// At `γ` = 0.3 it is §4.3's curve with the peak for which `y'(0) = 0`; at `γ = 0` (the
+    /// condition at C read as `y''(0) = 0`) it has no peak and falls over all of `D`
+    /// (`a_min + A0·(1 − 4u³ + 3u⁴)`). Used where the reach condition ([`REACH_SHARE`]) leaves
+    /// no room for a peak at `0.3·D` (see `reach_curve`).
+    pub fn fit_level(x0: f64, d: f64, peak: f64, a0: f64, a_min: f64) -> Option<AnkleCurve> {
+        let c = peak * d;
+        // c1 = 0; y'(C)/C = 2·c2 + 3·c3·C + 4·c4·C² = 0 (well-defined at C = 0).
+        let m = nalgebra::Matrix3::new(
+            2.0,
+            3.0 * c,
+            4.0 * c * c,
+            d * d,
+            d.powi(3),
+            d.powi(4),
+            2.0 * d,
+            3.0 * d * d,
+            4.0 * d.powi(3),
+        );
+        let rhs = nalgebra::Vector3::new(0.0, a_min - a0, 0.0);
+        let sol = m.lu().solve(&rhs)?;
+        let mut curve = AnkleCurve {
+            c: [a0, 0.0, sol[0], sol[1], sol[2]],
+            x0,
+            d,
+            heights: [a0, a0, a_min],
+        };
+        curve.heights[1] = curve.eval(x0 + c).0;
+        Some(curve)
+    }
+
+    /// `d²y/dx²` at ankle position `x` (absolute).
+    pub fn curvature(&self, x: f64) -> f64 {
+        let u = x - self.x0;
+        let c = &self.c;
+        2.0 * c[2] + u * (6.0 * c[3] + u * 12.0 * c[4])
     }
 
     /// `(y, dy/dx)` at ankle position `x` (absolute).
@@ -453,6 +492,9 @@ pub const RECOVERY_END: f64 = 0.85;
 /// strike), 3/4 ramped leaves it at 3.80.
 pub const SWING3_LEAD: f64 = 0.75;
 
+/// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
+const PEAK_AT: f64 = 0.3;
+
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
 
@@ -472,17 +514,6 @@ const LIFT_PER_TRAVEL: f64 = 0.25;
 /// same for steady walks but broke the first half step from standing (ratios > 1000). The
 /// swing1 clearance rounds still raise the curve where the toe needs it.
 const LIFT_SPEED_MIN: f64 = 3.0 / 3.6;
-
-/// Fraction of the lift added above the toe-off ankle height where that is above the
-/// landing height plus the lift (the paper lifts from `max(a0, a_min)`, §4.3 leaves the case open).
-///
-/// Why: slowing 7 → 1 km/h, the slow steps leave the ground with the ankle 8 cm above its
-/// heel-strike height on a short travel (D = 0.29 m); the full lift on top made the curve's far
-/// flank as steep as the circle the ankle can reach about the knee, and the slaved knee lost its
-/// root (a one-frame 0.4 m ankle jump: `REST=1 STOP=1 kjumps 7x4,1x4 2.0 5` 73.5 → 4.62).
-/// 0 (no lift above a0) made the quartic dip below a0 after toe-off (53.2 at toe-off); 0.5
-/// left 5.16. Steady walks: 2 km/h 3.5–4.5 → 3.2–3.4, others unchanged.
-const LIFT_OVER_TOE_OFF: f64 = 0.25;
 
 impl SwingSpec<'_> {
     /// The kinematic swing foot of this swing.
@@ -532,11 +563,18 @@ impl SwingSpec<'_> {
     }
 
     /// The ankle curve from the toe-off state.
+    ///
+    /// `reach` holds `(ankle x, shank inclination φ = θ3 + θ4)` along a swing1 already
+    /// simulated on this swing's curve (empty at first): the peak `a_max` is then also bounded
+    /// so that the curve's flank descends at most at angle `(1 − REACH_SHARE)·φ` where the
+    /// ankle passed (see [`REACH_SHARE`]; [`SwingSpec::solve_with`] repeats swing1 with it where
+    /// a simulated swing1 came closer to the reach circle's tangent than that).
     pub fn curve(
         &self,
         start: &SwingStart,
         speed: f64,
         extra_lift: f64,
+        reach: &[[f64; 2]],
     ) -> Result<AnkleCurve, String> {
         let [t0, t1, _, _] = self.times;
         let (_, a0) = self.joints(t0, &start.q);
@@ -608,36 +646,25 @@ impl SwingSpec<'_> {
         }
         let a_min = a1[1] + extra_lift;
         let lift = (self.ankle_lift / speed.max(LIFT_SPEED_MIN)).min(LIFT_PER_TRAVEL * d);
-        // The peak clears the landing height by the full lift, but an ankle that leaves the
-        // ground already higher (a slow step after fast ones) is lifted only LIFT_OVER_TOE_OFF
-        // of it: see there.
-        let a_max = (a0[1] + LIFT_OVER_TOE_OFF * lift).max(a_min + lift);
-        AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
-            .ok_or_else(|| "ankle curve is singular".to_string())
+        // §4.3's peak, lowered (and the curve reshaped) where a swing1 on it came too close to
+        // the ankle's reach about the knee: see `reach_curve`.
+        let a_max = a0[1].max(a_min) + lift;
+        if reach.is_empty() {
+            AnkleCurve::fit(a0[0], d, a0[1], a_max, a_min)
+        } else {
+            reach_curve(a0[0], d, a0[1], a_max, a_min, reach)
+        }
+        .ok_or_else(|| "ankle curve is singular".to_string())
     }
 
-    /// The knee angle that puts the ankle on the curve, by Newton from `guess`.
+    /// The knee angle that puts the ankle on the curve, continuing the branch of `guess` (the
+    /// knee of the last evaluation, at most one integration step earlier): see
+    /// [`knee_on_circle`].
     fn knee_on_curve(&self, t: f64, th3: f64, curve: &AnkleCurve, guess: f64) -> f64 {
         let h = (self.hip)(t).pos;
-        let (l3, l4) = (self.model.l3, self.model.l4);
+        let l3 = self.model.l3;
         let k = [h[0] - l3 * th3.sin(), h[1] - l3 * th3.cos()];
-        let mut th4 = guess;
-        for _ in 0..30 {
-            let (s, c) = (th3 + th4).sin_cos();
-            let a = [k[0] - l4 * s, k[1] - l4 * c];
-            let (y, dy) = curve.eval(a[0]);
-            let f = a[1] - y;
-            let df = l4 * s + dy * l4 * c;
-            if df.abs() < 1e-12 {
-                break;
-            }
-            let step = (f / df).clamp(-0.2, 0.2);
-            th4 -= step;
-            if step.abs() < 1e-14 {
-                break;
-            }
-        }
-        th4
+        knee_on_circle(k, self.model.l4, th3, curve, guess)
     }
 
     fn swing1(
@@ -665,7 +692,8 @@ impl SwingSpec<'_> {
                 [y[1], acc[0]]
             };
             if let Some(r) = rec.as_deref_mut() {
-                r.push(self.node1(sa, &y, curve, a, tau));
+                let guess = r.nodes.last().map_or(start.q[1], |n| n.q[1]);
+                r.push(self.node1(sa, &y, curve, a, tau, guess));
             }
             let recording = rec.is_some();
             let mut nodes: Vec<(f64, [f64; 2])> = Vec::new();
@@ -678,7 +706,8 @@ impl SwingSpec<'_> {
             let end = integrate(&mut f, sa, y, sb, h, no, &mut obs);
             if let Some(r) = rec.as_deref_mut() {
                 for (t, yy) in nodes {
-                    r.push(self.node1(t, &yy, curve, a, tau));
+                    let guess = r.nodes.last().map_or(start.q[1], |n| n.q[1]);
+                    r.push(self.node1(t, &yy, curve, a, tau, guess));
                 }
             }
             y = end.y;
@@ -686,9 +715,17 @@ impl SwingSpec<'_> {
         y
     }
 
-    fn node1(&self, t: f64, y: &[f64; 2], curve: &AnkleCurve, a: f64, tau: f64) -> Node<2> {
+    fn node1(
+        &self,
+        t: f64,
+        y: &[f64; 2],
+        curve: &AnkleCurve,
+        a: f64,
+        tau: f64,
+        guess: f64,
+    ) -> Node<2> {
         let [t0, ..] = self.times;
-        let th4 = self.knee_on_curve(t, y[0], curve, 0.8);
+        let th4 = self.knee_on_curve(t, y[0], curve, guess);
         let eps = 1e-5;
         let hip = (self.hip)(t);
         let ft = a * (-(t - t0) / tau).exp();
@@ -873,8 +910,13 @@ impl SwingSpec<'_> {
         let mut a_guess = guess[0];
         let mut lift_rounds = 0;
         let mut slope1 = carry.swing1_slope;
+        // Where a swing1 came closer to the reach circle's tangent than REACH_SHARE allows, the
+        // samples `(ankle x, φ)` of every such round bound the peak of the next (see
+        // `reach_peak`; the union only ever lowers it, so the rounds cannot oscillate).
+        let mut reach: Vec<[f64; 2]> = Vec::new();
+        let mut reach_rounds = 0;
         let (a1, curve, mut track, y1) = loop {
-            let curve = self.curve(start, speed, extra)?;
+            let curve = self.curve(start, speed, extra, &reach)?;
             let s1 = solve_1d_with(
                 |a| self.swing1(start, &curve, a, tau1, h, None)[0] - self.theta3_hs,
                 a_guess,
@@ -901,11 +943,20 @@ impl SwingSpec<'_> {
                 };
                 deficit = deficit.max(need - low);
             }
-            if deficit <= 0.0 || lift_rounds >= 10 {
+            if deficit > 0.0 && lift_rounds < 10 {
+                extra += deficit + 1e-3;
+                lift_rounds += 1;
+            } else if reach_rounds < REACH_ROUNDS
+                && reach_excess(self, &track, &curve) < -REACH_SLACK
+            {
+                reach.extend(track.nodes.iter().map(|n| {
+                    let (_, a) = self.joints(n.t, &n.q);
+                    [a[0], n.q[0] + n.q[1]]
+                }));
+                reach_rounds += 1;
+            } else {
                 break (s1.x[0], curve, track, y1);
             }
-            extra += deficit + 1e-3;
-            lift_rounds += 1;
             a_guess = s1.x[0];
         };
         let last = *track.nodes.last().ok_or("swing1 recorded nothing")?;
@@ -1146,6 +1197,246 @@ impl Hasher for TimeHasher {
     }
 }
 
+/// The knee angle θ4 that puts the ankle, on the circle of radius `l4` about the knee `k`
+/// with the thigh at `th3`, on `curve`, continuing the branch of `guess`.
+///
+/// The root is Newton's from `guess` when it lies on the knee's branch: the ankle residual
+/// `F(θ4) = a_y − P(a_x)` rises with θ4 there (the ankle crosses the curve from below as the knee
+/// flexes: the transversality `sin(φ − ψ)` of [`REACH_SHARE`] is positive) and the root is within
+/// [`KNEE_BRANCH_STEP`] of `guess`. Otherwise, the extremum of `F` next to `guess`
+/// (`∂F/∂θ4 = 0`, where the circle runs parallel to the curve) tells which case it is: where it
+/// is a minimum below zero (or a maximum above), the branch's root lies on its rising side and is
+/// found there by bisection (near a fold Newton can overshoot onto the partner root); where it
+/// is not, the curve has left the ankle's reach about the knee (past a fold, where the branch's
+/// root merged with its partner and vanished) and the ankle is put at that extremum, the point
+/// of its circle nearest the curve. At the fold that is where the lost root was, so the knee
+/// moves on continuously, and when the curve comes back within reach the root re-emerges
+/// there. Failing all (no extremum within [`KNEE_BRANCH_STEP`]) the knee is held at `guess`.
+/// Before this guard Newton went to whatever root it found.
+pub fn knee_on_circle(k: [f64; 2], l4: f64, th3: f64, curve: &AnkleCurve, guess: f64) -> f64 {
+    // F and ∂F/∂θ4 (the ankle moves by l4·(−cos, sin)(θ3 + θ4) per radian of knee flexion).
+    let res = |th4: f64| {
+        let (s, c) = (th3 + th4).sin_cos();
+        let ax = k[0] - l4 * s;
+        let (y, dy) = curve.eval(ax);
+        (k[1] - l4 * c - y, l4 * (s + dy * c), ax, s, c, dy)
+    };
+    let mut th4 = guess;
+    for _ in 0..30 {
+        let (f, df, ..) = res(th4);
+        if df.abs() < 1e-12 {
+            break;
+        }
+        let step = (f / df).clamp(-0.2, 0.2);
+        th4 -= step;
+        if step.abs() < 1e-14 {
+            break;
+        }
+    }
+    let (f, df, ..) = res(th4);
+    if f.abs() < 1e-9 && df > 0.0 && (th4 - guess).abs() <= KNEE_BRANCH_STEP {
+        return th4;
+    }
+    // Newton missed the branch (near a fold it can overshoot onto the partner root). The
+    // extremum of F next to `guess`: Newton on ∂F/∂θ4 = l4·(s + P'·c) = 0.
+    let mut ext = guess;
+    let mut curv = 0.0;
+    for _ in 0..30 {
+        let (_, g, ax, s, c, dy) = res(ext);
+        curv = l4 * (c - dy * s - l4 * c * c * curve.curvature(ax));
+        if curv.abs() < 1e-12 {
+            break;
+        }
+        let step = (g / curv).clamp(-0.05, 0.05);
+        ext -= step;
+        if step.abs() < 1e-14 {
+            break;
+        }
+    }
+    let (fe, g, ..) = res(ext);
+    if !(g.abs() < 1e-9 && ext.is_finite() && (ext - guess).abs() <= KNEE_BRANCH_STEP) {
+        return guess;
+    }
+    // The branch's root (F rising through 0) next to the extremum: above a minimum below 0,
+    // below a maximum above 0; else the curve is out of reach and the extremum is the point
+    // nearest it.
+    let dir = if curv > 0.0 && fe < 0.0 {
+        1.0
+    } else if curv < 0.0 && fe > 0.0 {
+        -1.0
+    } else {
+        return ext;
+    };
+    let (mut a, mut b) = (ext, ext);
+    let mut width = 1e-3;
+    while width <= 2.0 * KNEE_BRANCH_STEP {
+        b = ext + dir * width;
+        if res(b).0 * dir > 0.0 {
+            break;
+        }
+        a = b;
+        width *= 2.0;
+    }
+    if res(b).0 * dir <= 0.0 {
+        return ext;
+    }
+    for _ in 0..60 {
+        let m = 0.5 * (a + b);
+        if res(m).0 * dir > 0.0 {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    let root = 0.5 * (a + b);
+    if (root - guess).abs() <= KNEE_BRANCH_STEP {
+        root
+    } else {
+        ext
+    }
+}
+
+/// Largest change of the slaved swing1 knee between two evaluations of [`knee_on_circle`]
+/// (at most one integration step apart, ≤ 5 ms), rad: a root further from the last knee is on
+/// another branch. With the curve's flank kept off the reach circle's tangent
+/// ([`REACH_SHARE`]) the knee moves far less than that per step.
+pub const KNEE_BRANCH_STEP: f64 = 0.25;
+
+/// Least share of the shank's inclination kept between swing1's ankle curve `P` and the circle
+/// the ankle can reach about the knee: the curve's angle of descent `ψ = −atan P'` where the
+/// ankle is may be at most `(1 − REACH_SHARE)·φ`, `φ = θ3 + θ4` the shank's inclination from the
+/// vertical (the ankle behind the knee); the transversality `sin(φ − ψ)` is then at least
+/// `sin(REACH_SHARE·φ)`.
+///
+/// Derivation (the condition for the slaved knee to keep its root). In swing1 the thigh θ3 is
+/// driven by the dynamics, so the knee `k(t)` is given, and the ankle must lie both on the
+/// circle of radius `l4` about `k` and on `P`. The residual `F(θ4) = a_y − P(a_x)` has
+/// `∂F/∂θ4 = l4·(sin φ + P'·cos φ) = l4·√(1 + P'²)·sin(φ − ψ)`: the root is regular, and
+/// moves continuously with the knee, exactly while `φ > ψ` (a knee extension moves the ankle
+/// forward and down at `φ` below the horizontal, so it can follow a descent only less steep than
+/// that). The ankle's speed along the curve is `|v_k · r| / sin(φ − ψ)` (`r` the unit shank,
+/// `v_k` the knee's velocity): as `φ − ψ → 0` the ankle races down the flank (a near-fold:
+/// knee 188 rad/s for 4 ms), and beyond it the root is lost. Leaving the hip's reach annulus
+/// (`|l3 − l4| ≤ |a − h| ≤ l3 + l4`) is *not* what happens: the fold comes first, on the
+/// falling flank late in swing1 (60–90 % of `D`, where `ψ` is largest while the thigh is
+/// nearly forward), with the ankle well inside the annulus.
+///
+/// Where it gets small (measured along the simulated swing1): a short travel `D`, a toe-off
+/// ankle high above its landing height (a slow step after fast ones) and a large lift (slow
+/// walks) steepen the flank, and a short step's shank is less inclined at the end of swing1.
+/// Steady walks 1–7 km/h × 1.5–2.0 m keep `sin(φ − ψ)` at 0.21–0.47 (least at 1 km/h, rising
+/// with speed). With §4.3's peak (`max(a0, a_min) + lift`): slowing 7 → 1 km/h (the stop's half
+/// step, its ankle leaving 8 cm above its landing height on a 0.29 m travel) 0.003–0.016
+/// (continuity 11–73); 2 km/h steady walks 0.18 (4.0–4.5; 0.27 → 3.2–3.4); the first swing from
+/// standing into 6 → 1 km/h × 1.6 m 0.18 at φ = 0.37 (knee 5.2). 0.6 (the flank descends at
+/// most 40 % as steeply, in angle, as the shank leans; `sin(φ − ψ) ≥ 0.35` at the usual
+/// φ ≈ 0.6, an ankle speed at most 2.9× the knee's along the shank) was measured against 0.5
+/// (leaves the last case at 5.2) and a fixed `sin(φ − ψ) ≥ 0.2, 0.25, 0.3` (2 km/h 4.0–4.2,
+/// 3.4–3.7, 3.2–3.4 and the first-swing case 5.2); it leaves every steady walk and the
+/// schedule 2 → 5 → 3 km/h as they were (1 km/h × 1.8 m 3.31 → 3.25), and it replaces the tuned
+/// `LIFT_OVER_TOE_OFF` (0.25 of the lift over a high toe-off ankle) by §4.3's own peak.
+pub const REACH_SHARE: f64 = 0.6;
+
+/// Largest number of swing1 repeats with the peak bounded by `reach_curve`.
+const REACH_ROUNDS: usize = 4;
+
+/// How far below `sin(REACH_SHARE·φ)` a swing1 may stay after a round of `reach_curve` (its bound
+/// is met at the samples of the round before; lowering the peak also lowers the shank's
+/// inclination a little).
+const REACH_SLACK: f64 = 0.02;
+
+/// The least excess of the transversality `sin(φ − ψ)` over its required value (see
+/// [`REACH_SHARE`]) over the nodes of a simulated swing1.
+fn reach_excess(spec: &SwingSpec<'_>, track: &Track<2>, curve: &AnkleCurve) -> f64 {
+    track
+        .nodes
+        .iter()
+        .map(|n| {
+            let (_, a) = spec.joints(n.t, &n.q);
+            let dy = curve.eval(a[0]).1;
+            let phi = n.q[0] + n.q[1];
+            (phi.sin() + dy * phi.cos()) / (1.0 + dy * dy).sqrt() - (REACH_SHARE * phi).sin()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// The ankle curve from `(x0, a0)` to `(x0 + d, a_min)` with peak at most `a_max` whose flank
+/// keeps [`REACH_SHARE`] to the reach circle at the samples `(ankle x, φ)` of `reach`, i.e.
+/// descends at most at `tan((1 − REACH_SHARE)·φ)` where the ankle passed.
+///
+/// First the paper's quartic with a lower peak: it is linear in its heights,
+/// `y = a_min + H·f(u) + A0·g(u)` (`u = (x − x0)/d`, `H = a_max − a_min`, `A0 = a0 − a_min`,
+/// `f` and `g` the curves of unit `H` and unit `A0`), so each sample bounds `H` where
+/// `f'(u) < 0`. The peak is not lowered below the one for which the curve leaves `a0` level
+/// (`y'(0) = 0`, `H = 1.115·A0`): lower, it dips after toe-off. Where that is still too steep
+/// (a toe-off ankle far above the landing height on a short travel: the drop `A0` alone makes
+/// the flank too steep after a peak at `0.3·D`) the peak moves towards toe-off instead, along
+/// the quartics that leave `a0` level with a peak at `γ·D` ([`AnkleCurve::fit_level`],
+/// `γ` from 0.3 to 0, where the peak is gone and the descent is spread over all of `D`): the
+/// largest `γ` that keeps the margin, by bisection, `γ = 0` if none does (the knee's guard,
+/// [`knee_on_circle`], then keeps the knee continuous).
+fn reach_curve(
+    x0: f64,
+    d: f64,
+    a0: f64,
+    a_max: f64,
+    a_min: f64,
+    reach: &[[f64; 2]],
+) -> Option<AnkleCurve> {
+    // The samples on the curve, with the steepest descent they allow.
+    let samples: Vec<(f64, f64)> = reach
+        .iter()
+        .filter(|&&[x, phi]| (x0..=x0 + d).contains(&x) && phi.is_finite())
+        .map(|&[x, phi]| {
+            (
+                (x - x0) / d,
+                ((1.0 - REACH_SHARE) * phi).clamp(0.0, 1.4).tan(),
+            )
+        })
+        .collect();
+    let (f, g) = (
+        AnkleCurve::fit(0.0, 1.0, 0.0, 1.0, 0.0)?,
+        AnkleCurve::fit(0.0, 1.0, 1.0, 0.0, 0.0)?,
+    );
+    let a0_rel = a0 - a_min;
+    let mut h = a_max - a_min;
+    for &(u, allowed) in &samples {
+        let (fd, gd) = (f.eval(u).1, g.eval(u).1);
+        if fd < 0.0 {
+            h = h.min((allowed * d + a0_rel * gd) / -fd);
+        }
+    }
+    // y'(0) = (H·f'(0) + A0·g'(0))/d ≥ 0.
+    let level = -a0_rel * g.eval(0.0).1 / f.eval(0.0).1;
+    if h >= a_max - a_min {
+        return AnkleCurve::fit(x0, d, a0, a_max, a_min);
+    }
+    if h >= level {
+        return AnkleCurve::fit(x0, d, a0, a_min + h, a_min);
+    }
+    let keeps = |c: &AnkleCurve| {
+        samples
+            .iter()
+            .all(|&(u, allowed)| -c.eval(x0 + u * d).1 <= allowed)
+    };
+    let (mut lo, mut hi) = (0.0, PEAK_AT);
+    let mut best = AnkleCurve::fit_level(x0, d, 0.0, a0, a_min)?;
+    if !keeps(&best) {
+        return Some(best);
+    }
+    for _ in 0..30 {
+        let mid = 0.5 * (lo + hi);
+        let c = AnkleCurve::fit_level(x0, d, mid, a0, a_min)?;
+        if keeps(&c) {
+            lo = mid;
+            best = c;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(best)
+}
+
 /// A one-unknown solve in the two-unknown form of the braked swing (the second unknown, the
 /// brake or landing-rate ramp, fixed at 0).
 fn padded(s: Solved<1>) -> Solved<2> {
@@ -1304,5 +1595,134 @@ mod tests {
             jump < 0.2 * hard_jump,
             "rate jump {jump} rad/s vs {hard_jump} with a hard maximum"
         );
+    }
+
+    #[test]
+    fn the_slaved_knee_follows_its_branch_past_a_fold() {
+        // The ankle held on a straight flank descending at ψ = 0.5 rad; the knee (thigh fixed)
+        // moves away from it, perpendicular, from 0.3 m to 0.6 m and back (shank 0.45 m). While
+        // the flank is within reach the ankle is on it, on the knee's branch (φ > ψ); beyond,
+        // no root exists and the ankle is at the circle's point nearest the flank (φ = ψ, where
+        // the two roots merged); the knee never jumps, and comes back onto its branch.
+        let psi: f64 = 0.5;
+        let line = AnkleCurve {
+            c: [0.0, -psi.tan(), 0.0, 0.0, 0.0],
+            x0: 0.0,
+            d: 1.0,
+            heights: [0.0; 3],
+        };
+        let (l4, th3) = (0.45, -0.2);
+        let normal = [psi.sin(), psi.cos()];
+        let foot = [0.4, -0.4 * psi.tan()];
+        let n = 3000;
+        let dists: Vec<f64> = (0..=2 * n)
+            .map(|i| 0.3 + 0.3 * (1.0 - (i as f64 / n as f64 - 1.0).abs()))
+            .collect();
+        let mut th4 = {
+            // Start on the branch: φ − ψ = acos(0.3/0.45).
+            (0.3f64 / l4).acos() + psi - th3
+        };
+        let (mut lost, mut on) = (0, 0);
+        for &dist in &dists {
+            let k = [foot[0] + dist * normal[0], foot[1] + dist * normal[1]];
+            let next = knee_on_circle(k, l4, th3, &line, th4);
+            assert!((next - th4).abs() < 0.03, "jump {th4} -> {next} at {dist}");
+            th4 = next;
+            let phi = th3 + th4;
+            let ankle = [k[0] - l4 * phi.sin(), k[1] - l4 * phi.cos()];
+            let f = ankle[1] - line.eval(ankle[0]).0;
+            if dist < l4 - 1e-3 {
+                assert!(
+                    f.abs() < 1e-9 && phi > psi,
+                    "off the branch at {dist}: {f} {phi}"
+                );
+                on += 1;
+            } else if dist > l4 + 1e-3 {
+                assert!(
+                    (phi - psi).abs() < 1e-6,
+                    "not the nearest point at {dist}: {phi}"
+                );
+                assert!((f * psi.cos() - (dist - l4)).abs() < 1e-9, "{f} at {dist}");
+                lost += 1;
+            }
+        }
+        assert!(lost > 1000 && on > 1000, "{lost} {on}");
+    }
+
+    #[test]
+    fn the_reach_bound_lowers_the_peak_then_moves_it_towards_toe_off() {
+        let tan = |phi: f64| ((1.0 - REACH_SHARE) * phi).tan();
+        let check = |c: &AnkleCurve, a0: f64, a_min: f64, d: f64, phi: f64| {
+            // At the samples (those of `samples` below).
+            for i in 0..=50 {
+                let x = d * i as f64 / 50.0;
+                assert!(-c.eval(x).1 <= tan(phi) + 1e-9, "too steep at {x}");
+            }
+            assert!((c.eval(0.0).0 - a0).abs() < 1e-12 && c.eval(0.0).1 >= -1e-12);
+            assert!((c.eval(d).0 - a_min).abs() < 1e-12 && c.eval(d).1.abs() < 1e-12);
+        };
+        let samples = |d: f64, phi: f64| -> Vec<[f64; 2]> {
+            (0..=50).map(|i| [d * i as f64 / 50.0, phi]).collect()
+        };
+        // A steady walk's curve that keeps the margin: unchanged.
+        let (d, a0, a_min, a_max) = (0.6, 0.12, 0.15, 0.19);
+        let plain = AnkleCurve::fit(0.0, d, a0, a_max, a_min).unwrap();
+        let kept = reach_curve(0.0, d, a0, a_max, a_min, &samples(d, 0.6)).unwrap();
+        assert_eq!(kept.heights, plain.heights);
+        for (a, b) in kept.c.iter().zip(&plain.c) {
+            assert!((a - b).abs() < 1e-12, "{kept:?}");
+        }
+        // A slow step after fast ones (a0 8 cm above a_min on a short travel, §4.3's peak 2 cm
+        // higher): §4.3's flank is far too steep, and a lower peak at 0.3·D still is (the drop
+        // alone), so the peak moves towards toe-off, leaving a0 level.
+        let (d, a0, a_min, phi) = (0.4, 0.215, 0.137, 0.9);
+        let steepest = |c: &AnkleCurve| {
+            (0..=50)
+                .map(|i| -c.eval(d * i as f64 / 50.0).1)
+                .fold(0.0, f64::max)
+        };
+        let paper = AnkleCurve::fit(0.0, d, a0, a0 + 0.021, a_min).unwrap();
+        let level = AnkleCurve::fit_level(0.0, d, PEAK_AT, a0, a_min).unwrap();
+        assert!(steepest(&paper) > tan(phi) && steepest(&level) > tan(phi));
+        let c = reach_curve(0.0, d, a0, a0 + 0.021, a_min, &samples(d, phi)).unwrap();
+        check(&c, a0, a_min, d, phi);
+        assert!(
+            c.heights[1] < level.heights[1] && c.heights[1] >= a0,
+            "{:?}",
+            c.heights
+        );
+        assert!(c.eval(0.0).1.abs() < 1e-12);
+        // Where no curve of the family keeps the margin: the flattest, without a peak.
+        let (d, phi) = (0.289, 0.62);
+        let c = reach_curve(0.0, d, a0, a0 + 0.021, a_min, &samples(d, phi)).unwrap();
+        assert_eq!(c, AnkleCurve::fit_level(0.0, d, 0.0, a0, a_min).unwrap());
+        // A milder drop only lowers §4.3's peak (still at 0.3·D, with zero slope there).
+        let (a0, a_min) = (0.16, 0.14);
+        let c = reach_curve(0.0, d, a0, a0 + 0.04, a_min, &samples(d, 0.62)).unwrap();
+        check(&c, a0, a_min, d, 0.62);
+        assert!(c.eval(0.3 * d).1.abs() < 1e-12 && c.heights[1] < a0 + 0.04);
+    }
+
+    #[test]
+    fn the_level_curves_join_the_papers_and_lose_their_peak() {
+        let (d, a0, a_min) = (0.4, 0.2, 0.1);
+        // At γ = 0.3: §4.3's quartic with the peak for which y'(0) = 0 (H = 1.115·A0).
+        let at = AnkleCurve::fit_level(0.0, d, PEAK_AT, a0, a_min).unwrap();
+        let paper = AnkleCurve::fit(0.0, d, a0, at.heights[1], a_min).unwrap();
+        for i in 0..=20 {
+            let x = d * i as f64 / 20.0;
+            assert!((at.eval(x).0 - paper.eval(x).0).abs() < 1e-12);
+        }
+        assert!(paper.eval(0.0).1.abs() < 1e-12);
+        let h = (at.heights[1] - a_min) / (a0 - a_min);
+        assert!((h - 1.115).abs() < 1e-3, "{h}");
+        // At γ = 0: a_min + A0·(1 − 4u³ + 3u⁴), monotone.
+        let flat = AnkleCurve::fit_level(0.0, d, 0.0, a0, a_min).unwrap();
+        for i in 0..=20 {
+            let u = i as f64 / 20.0;
+            let want = a_min + (a0 - a_min) * (1.0 - 4.0 * u.powi(3) + 3.0 * u.powi(4));
+            assert!((flat.eval(u * d).0 - want).abs() < 1e-12);
+            assert!(flat.eval(u * d).1 <= 1e-12);
+        }
     }
 }
