@@ -1402,12 +1402,13 @@ fn assemble(
     let swing_model = super::dynamics::SwingModel::new(body);
     let mut arms = ArmLag::new(opt.fps);
     // A steady walk's lead-in starts mid-motion: the arms' lag is run over the pre-roll's last
-    // frames before frame 0 (5 time constants, the lag's start forgotten to < 1 %), so frame 0's
-    // arms already trail their thighs as they do mid-walk instead of starting on them.
+    // frames before frame 0 (7 time constants, the two-stage lag's start forgotten to < 1 %), so
+    // frame 0's arms already trail their legs as they do mid-walk instead of starting on them.
     let warm = data.first().map_or(0, |d| {
+        let tau = arms.set_cycle(2.0 * d.times.step);
         ((-d.start).max(0.0) * opt.fps)
             .floor()
-            .min((5.0 * ARM_LAG * opt.fps).ceil()) as i64
+            .min((7.0 * tau * opt.fps).ceil()) as i64
     });
     for i in -warm..frames as i64 {
         let t = (i as f64 / opt.fps).min(total);
@@ -1420,6 +1421,7 @@ fn assemble(
         }
         let k = data.partition_point(|d| d.start <= t).saturating_sub(1);
         let d = &data[k];
+        arms.set_cycle(2.0 * d.times.step);
         let tau = (t - d.start).clamp(0.0, d.times.step);
         let (q, _, _) = d.stance.track.at(tau);
         let x_dyn = d.ankle_x + q[0] * q[1].sin();
@@ -1436,7 +1438,7 @@ fn assemble(
         let rho = interp_rho(&d.stance_rho, tau);
         let (ankle, pitch, bend) =
             foot.rolled(d.stance_leg.flat_ankle, rho, d.stance_leg.theta6_max);
-        let stance_thigh = place_leg(
+        let stance_axis = place_leg(
             skeleton,
             &mut pose,
             stance,
@@ -1445,7 +1447,7 @@ fn assemble(
             bend,
         );
         // Swing / trailing leg.
-        let (swing_thigh, contact_w) = if tau < d.swing_times[0] {
+        let (swing_axis, contact_w) = if tau < d.swing_times[0] {
             let rho = interp_rho(&d.trail_rho, tau);
             let (ankle, pitch, bend) =
                 foot.rolled(d.trail_leg.flat_ankle, rho, d.trail_leg.theta6_max);
@@ -1503,7 +1505,7 @@ fn assemble(
             &mut pose,
             a,
             &mut arms,
-            [(stance, swing_thigh), (swing, stance_thigh)],
+            [(stance, swing_axis), (swing, stance_axis)],
         );
         let mut contact = [false; 2];
         contact[match stance {
@@ -1623,12 +1625,12 @@ fn closing_pose(
                 bend,
             )
         };
-    let stance_thigh = place(&mut pose, w, f.stance_foot);
-    let trail_thigh = place(&mut pose, tr, f.trail_foot);
+    let stance_axis = place(&mut pose, w, f.stance_foot);
+    let trail_axis = place(&mut pose, tr, f.trail_foot);
     pose.set_world_rotation(Joint::Lumbar, DQuat::from_rotation_z(-f.lean));
     pose.set_euler(Joint::ThoracicUpper, Euler::new(0.0, 0.0, 0.0));
     pose.set_world_rotation(Joint::Head, DQuat::IDENTITY);
-    swing_arms(&mut pose, a, arms, [(w, trail_thigh), (tr, stance_thigh)]);
+    swing_arms(&mut pose, a, arms, [(w, trail_axis), (tr, stance_axis)]);
     let mut contact = [true; 2];
     contact[match tr {
         Side::Left => 0,
@@ -1638,67 +1640,122 @@ fn closing_pose(
 }
 
 /// The arms swing with the opposite leg (§4.3): shoulder flexion = −(arm gain) × the opposite
-/// thigh's angle, the elbow flexed by its attribute plus half of any forward shoulder flexion.
-/// One rule for the walk and the stop, so the hands cannot jump where one hands over to the
-/// other. `sides`: (arm's side, opposite thigh angle θ3, rad).
+/// leg's angle (hip to ankle, lagged by [`ArmLag`]), the elbow flexed by its attribute plus half
+/// of any forward shoulder flexion. One rule for the walk and the stop, so the hands cannot jump
+/// where one hands over to the other. `sides`: (arm's side, opposite leg's sagittal angle, rad,
+/// positive behind the hip).
+///
+/// The paper says only that "the arms swing forward with the opposite legs" (§4.3); we take the
+/// leg as the hip–ankle line (the model's leg, θ1 in stance), not the thigh: the thigh also turns
+/// with the knee, and at heel strike its knee-driven turns are fast and brief (the landing
+/// stance knee flexing ≈ 0.13 rad in a frame at 7 km/h × 1.5 m turns the stance thigh forward
+/// 0.09 rad in 4 frames while the leg's axis keeps rotating back smoothly). Worst shoulder or
+/// elbow ratio over 1–7 km/h × 1.5–2.0 m with the earlier one-stage lag of 30 ms: thigh 5.95
+/// (7 km/h × 1.5 m, one frame before heel strike), leg axis 3.9. Over a stride the leg's axis swings 10–20 % more than the thigh and ≈ 5°
+/// further back: at the unchanged gain (with [`ArmLag::gain`]) the arm's swing each way,
+/// measured 10.7 / 17.7 / 23.9° at 1 km/h × 1.8 m, 4 km/h × 1.8 m, 7 km/h × 1.5 m, is within
+/// 12 % of the thigh-driven one (12.1 / 16.4 / 22.5°), and its middle moves 4–5° towards
+/// extension, as a human's shoulder swings further behind the trunk than in front of it.
 fn swing_arms(
     pose: &mut crate::generator::skeleton::Pose,
     a: &WalkAttributes,
     arms: &mut ArmLag,
     sides: [(Side, f64); 2],
 ) {
-    let arm_gain = a.arm_swing_deg / 25.0;
-    for (side, thigh) in sides {
-        let opposite_thigh = arms.follow(side, thigh);
+    let arm_gain = a.arm_swing_deg / 25.0 * arms.gain();
+    for (side, leg) in sides {
+        let opposite_leg = arms.follow(side, leg);
         let [_, shoulder, elbow, _] = Joint::arm(side);
-        let flex = -arm_gain * opposite_thigh;
+        let flex = -arm_gain * opposite_leg;
         pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
         let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
         pose.set_euler(elbow, Euler::sagittal(elbow_flex));
     }
 }
 
-/// Time constant of the arms' lag behind the opposite thigh, s ([`ArmLag`]).
-const ARM_LAG: f64 = 0.03;
+/// Fraction of the stride cycle by which the arms trail the opposite leg ([`ArmLag`]): a human
+/// arm's ≈ 10 %.
+const ARM_LAG_CYCLE: f64 = 0.1;
 
-/// The arms follow the opposite thigh through a first-order lag of [`ARM_LAG`] (the arm is a
-/// pendulum driven at the shoulder, not welded to the thigh). Why: the thigh's rate changes
-/// within a frame or two at heel strike (the swing thigh lands retracting at the
-/// collision-neutral rate, the new stance thigh leaves at another), and a one-to-one copy put
-/// that kink into the shoulder (4 km/h, 1.8/2.0 m: r_shoulder 6.1/6.4 × its neighbours' step
-/// on the last frame before heel strike). The lag keeps the arm's rate continuous (C¹ angle)
-/// and delays it by ≈ 30 ms, under a tenth of a step. In the stop's closing the lag fades out
-/// (smoothstep over the closing), so the arms come to rest exactly when the legs do.
+/// The arms follow the opposite leg through a critically damped second-order lag: two equal
+/// first-order stages, each delaying the stride's fundamental by half of [`ARM_LAG_CYCLE`]
+/// (continuous time: τ = tan(π·ARM_LAG_CYCLE)·cycle/2π, 45 ms at 7 km/h × 1.5 m, 130 ms at
+/// 1 km/h × 1.8 m), with the gain the two stages take from the fundamental, cos²(π·ARM_LAG_CYCLE)
+/// = 0.905, given back ([`ArmLag::gain`]).
+///
+/// Why: the arm is a pendulum driven at the shoulder, not welded to the leg, and the leg's rate
+/// changes within a frame or two at heel strike (the swing leg stops flexing and lands
+/// retracting at the collision-neutral rate: at 7 km/h × 1.5 m −1.4 → +2.2 rad/s over the last
+/// three frames). A one-to-one copy put that kink into the shoulder (4 km/h, 1.8/2.0 m: 6.1/6.4 ×
+/// its neighbours' step); one stage of 30 ms kept the arm's angle C¹ but passed the kink as a
+/// one-frame dip of its rate, which, where the arm turns at the opposite heel strike and its
+/// steps are smallest, made the shoulder joint's step 5.95 × its neighbours' at 7 km/h × 1.5 m.
+/// Two stages make the angle C² (the dip is spread over the lag). Measured, worst shoulder or
+/// elbow ratio over 1–7 km/h × 1.5–2.0 m and the 2 → 5 → 3 km/h schedule, leg axis as input:
+/// one stage of 30 ms 3.9; two of 30 / 40 ms 3.5 / 2.5 (8 % of the cycle at 7 km/h, 3 % at
+/// 1 km/h); this cycle-scaled 10 %, 3.5 (7 km/h × 1.5 m; the thigh as input, 5.2 at 5 km/h ×
+/// 1.5 m). Each step sets the lag for its own cycle (two of its steps); a change of speed changes
+/// the filter's weight, not its state, so the arm stays C¹. In the stop's closing the lag fades
+/// out (smoothstep over the closing), so the arms come to rest exactly when the legs do.
 struct ArmLag {
-    /// Filter weight per frame, 1 − exp(−Δt/τ).
+    /// Frame rate, frames/s.
+    fps: f64,
+    /// Filter weight per frame and stage, 1 − exp(−Δt/τ).
     alpha: f64,
-    /// How far the lag has faded out, 0 (full lag) to 1 (the arm copies the thigh).
+    /// How far the lag has faded out, 0 (full lag) to 1 (the arm copies the leg).
     settle: f64,
-    /// The lagged thigh angle per arm (left, right), rad; `None` before the first frame.
-    state: [Option<f64>; 2],
+    /// The lagged leg angle per arm (left, right) after the first and the second stage, rad;
+    /// `None` before the first frame.
+    state: [Option<[f64; 2]>; 2],
 }
 
 impl ArmLag {
+    /// A lag for frames at `fps`, tuned to a 1 s cycle until [`ArmLag::set_cycle`].
     fn new(fps: f64) -> Self {
-        Self {
-            alpha: 1.0 - (-1.0 / (fps * ARM_LAG)).exp(),
+        let mut lag = Self {
+            fps,
+            alpha: 1.0,
             settle: 0.0,
             state: [None; 2],
-        }
+        };
+        lag.set_cycle(1.0);
+        lag
     }
 
-    /// Advances `side`'s arm by one frame towards the opposite thigh angle `thigh`.
-    fn follow(&mut self, side: Side, thigh: f64) -> f64 {
+    /// Tunes each stage to delay a stride of `cycle` s by half of [`ARM_LAG_CYCLE`]; returns its
+    /// time constant, s. The weight is the discrete stage's exact one: `y ← b·y + (1 − b)·u`
+    /// delays a sinusoid of θ rad per frame by φ where b = sin φ / sin(θ + φ).
+    fn set_cycle(&mut self, cycle: f64) -> f64 {
+        let phi = PI * ARM_LAG_CYCLE;
+        let theta = 2.0 * PI / (self.fps * cycle.max(1e-3));
+        let b = phi.sin() / (theta + phi).sin();
+        self.alpha = 1.0 - b;
+        -1.0 / (self.fps * b.ln())
+    }
+
+    /// The arm's gain on its lagged leg angle: what the two stages take from the stride's
+    /// fundamental given back, fading to 1 with the lag.
+    fn gain(&self) -> f64 {
+        let g = 1.0 / (PI * ARM_LAG_CYCLE).cos().powi(2);
+        g + (1.0 - g) * self.settle
+    }
+
+    /// Advances `side`'s arm by one frame towards the opposite leg's angle `leg`.
+    fn follow(&mut self, side: Side, leg: f64) -> f64 {
         let slot = &mut self.state[match side {
             Side::Left => 0,
             Side::Right => 1,
         }];
+        let w = self.alpha + (1.0 - self.alpha) * self.settle;
         let y = match *slot {
-            Some(y) => y + (self.alpha + (1.0 - self.alpha) * self.settle) * (thigh - y),
-            None => thigh,
+            Some([y1, y2]) => {
+                let y1 = y1 + w * (leg - y1);
+                [y1, y2 + w * (y1 - y2)]
+            }
+            None => [leg, leg],
         };
         *slot = Some(y);
-        y
+        y[1]
     }
 }
 
@@ -1898,7 +1955,8 @@ fn swing_span_target(
 }
 
 /// Places one leg: ankle at `ankle` (world), foot pitched by `pitch` with toe bend `bend`.
-/// Returns the sagittal thigh angle (positive: knee behind the hip).
+/// Returns the leg's sagittal angle, hip to ankle (positive: ankle behind the hip), which the
+/// opposite arm follows ([`swing_arms`]).
 fn place_leg(
     skeleton: &Skeleton,
     pose: &mut crate::generator::skeleton::Pose,
@@ -1914,8 +1972,8 @@ fn place_leg(
     pose.set_euler(mtp, Euler::sagittal(bend));
     let g = skeleton.forward(pose);
     let h = g.position(hip);
-    let kn = g.position(Joint::leg(side)[1]);
-    (h.x - kn.x).atan2(h.y - kn.y)
+    let an = g.position(ank);
+    (h.x - an.x).atan2(h.y - an.y)
 }
 
 /// How far forward the first swing leg's thigh may be at toe off from standing, as a fraction of
@@ -1974,26 +2032,85 @@ fn first_toe_off_knee(
 mod tests {
     use super::*;
 
-    /// The arm lag is a first-order lag of time constant `ARM_LAG`, independent of the frame
-    /// rate, per arm; faded out (`settle` = 1) the arm copies the thigh.
+    /// The arm lag is two equal first-order stages, per arm; faded out (`settle` = 1) the arm
+    /// copies the leg.
     #[test]
-    fn arm_lag_is_a_first_order_lag_that_fades_out() {
+    fn arm_lag_is_a_second_order_lag_that_fades_out() {
         for fps in [100.0, 120.0, 250.0] {
             let mut lag = ArmLag::new(fps);
+            let tau = lag.set_cycle(1.1);
+            // The discrete stage's time constant is the continuous one's, tan(π/10)·cycle/2π,
+            // plus ≈ half a frame (the stage takes the current frame's input: half a frame of
+            // lead that its weight gives back).
+            let lead = (tau - (0.1 * PI).tan() * 1.1 / (2.0 * PI)) * fps;
+            assert!(lead > 0.5 && lead < 0.6, "{fps} fps: {lead} frames");
             assert_eq!(lag.follow(Side::Left, 0.0), 0.0);
             assert_eq!(lag.follow(Side::Right, -0.5), -0.5);
-            // A unit step of the left thigh: after ARM_LAG the arm is 1 − 1/e of the way there.
-            let n = (ARM_LAG * fps).round() as usize;
+            // A unit step of the left leg: after n frames two stages of weight a have come
+            // 1 − (1 − a)ⁿ (1 + n a) of the way.
+            let n = (2.0 * tau * fps).round() as usize;
+            let a = 1.0 - (-1.0 / (fps * tau)).exp();
             let mut y = 0.0;
+            let mut steps = vec![];
             for _ in 0..n {
-                y = lag.follow(Side::Left, 1.0);
+                let y1 = lag.follow(Side::Left, 1.0);
+                steps.push(y1 - y);
+                y = y1;
             }
-            let expected = 1.0 - (-(n as f64) / (fps * ARM_LAG)).exp();
+            let expected = 1.0 - (1.0 - a).powi(n as i32) * (1.0 + n as f64 * a);
             assert!((y - expected).abs() < 1e-12, "{fps} fps: {y} vs {expected}");
+            // C¹: the step's rate starts from nothing (a² in the first frame, a one-stage lag's
+            // was a) and rises before it falls.
+            assert!((steps[0] - a * a).abs() < 1e-12);
+            assert!(steps[1] > steps[0]);
             // The other arm kept its own state.
             assert_eq!(lag.follow(Side::Right, -0.5), -0.5);
             lag.settle = 1.0;
-            assert_eq!(lag.follow(Side::Left, 0.3), 0.3);
+            assert!((lag.follow(Side::Left, 0.3) - 0.3).abs() < 1e-15);
+            assert_eq!(lag.gain(), 1.0);
+        }
+    }
+
+    /// At any stride cycle (0.85 s, 7 km/h × 1.5 m, to 2.5 s, 1 km/h × 1.8 m) and frame rate the
+    /// arm trails a sinusoidal leg by `ARM_LAG_CYCLE` of the cycle, and with its gain keeps the
+    /// leg's amplitude within 5 % (the discrete stages lose a little more than the continuous
+    /// cos² the gain gives back: 2.4 % at 100 fps and 4 % at 60 fps for a 0.85 s cycle).
+    #[test]
+    fn arm_lag_trails_the_leg_by_a_tenth_of_the_cycle() {
+        for fps in [60.0, 100.0, 250.0] {
+            for cycle in [0.85, 1.25, 2.5] {
+                let mut lag = ArmLag::new(fps);
+                lag.set_cycle(cycle);
+                let om = 2.0 * PI / cycle;
+                let m = cycle * fps;
+                let n = (8.0 * m) as usize;
+                let out: Vec<f64> = (0..n)
+                    .map(|i| lag.gain() * lag.follow(Side::Left, (om * i as f64 / fps).sin()))
+                    .collect();
+                // The last whole cycles: the output's fit a·sin + b·cos.
+                let k = (3.0 * m).floor() as usize;
+                let (mut s, mut c, mut ss, mut cc, mut sc) = (0.0, 0.0, 0.0, 0.0, 0.0);
+                for (i, y) in out.iter().enumerate().skip(n - k) {
+                    let (sn, cs) = (om * i as f64 / fps).sin_cos();
+                    s += y * sn;
+                    c += y * cs;
+                    ss += sn * sn;
+                    cc += cs * cs;
+                    sc += sn * cs;
+                }
+                let det = ss * cc - sc * sc;
+                let (fa, fb) = ((s * cc - c * sc) / det, (c * ss - s * sc) / det);
+                let amp = fa.hypot(fb);
+                let delay = (-fb).atan2(fa) / (2.0 * PI);
+                assert!(
+                    (amp - 1.0).abs() < 0.05,
+                    "{fps} fps, {cycle} s: amplitude {amp}"
+                );
+                assert!(
+                    (delay - ARM_LAG_CYCLE).abs() < 1e-9,
+                    "{fps} fps, {cycle} s: delay {delay} of the cycle"
+                );
+            }
         }
     }
 
