@@ -1641,7 +1641,7 @@ fn closing_pose(
 
 /// The arms swing with the opposite leg (§4.3): shoulder flexion = −(arm gain) × the opposite
 /// leg's angle (hip to ankle, lagged by [`ArmLag`]), the elbow flexed by its attribute plus half
-/// of any forward shoulder flexion. One rule for the walk and the stop, so the hands cannot jump
+/// of any forward shoulder flexion (its start rounded, [`soft_positive`]). One rule for the walk and the stop, so the hands cannot jump
 /// where one hands over to the other. `sides`: (arm's side, opposite leg's sagittal angle, rad,
 /// positive behind the hip).
 ///
@@ -1652,7 +1652,7 @@ fn closing_pose(
 /// 0.09 rad in 4 frames while the leg's axis keeps rotating back smoothly). Worst shoulder or
 /// elbow ratio over 1–7 km/h × 1.5–2.0 m with the earlier one-stage lag of 30 ms: thigh 5.95
 /// (7 km/h × 1.5 m, one frame before heel strike), leg axis 3.9. Over a stride the leg's axis swings 10–20 % more than the thigh and ≈ 5°
-/// further back: at the unchanged gain (with [`ArmLag::gain`]) the arm's swing each way,
+/// further back: at the unchanged gain (with `ArmLag::gain`) the arm's swing each way,
 /// measured 10.7 / 17.7 / 23.9° at 1 km/h × 1.8 m, 4 km/h × 1.8 m, 7 km/h × 1.5 m, is within
 /// 12 % of the thigh-driven one (12.1 / 16.4 / 22.5°), and its middle moves 4–5° towards
 /// extension, as a human's shoulder swings further behind the trunk than in front of it.
@@ -1662,14 +1662,33 @@ fn swing_arms(
     arms: &mut ArmLag,
     sides: [(Side, f64); 2],
 ) {
-    let arm_gain = a.arm_swing_deg / 25.0 * arms.gain();
+    let arm_gain = a.arm_swing_deg / 25.0 * ArmLag::gain();
     for (side, leg) in sides {
         let opposite_leg = arms.follow(side, leg);
         let [_, shoulder, elbow, _] = Joint::arm(side);
         let flex = -arm_gain * opposite_leg;
         pose.set_world_rotation(shoulder, DQuat::from_rotation_z(flex));
-        let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * flex.max(0.0);
+        let elbow_flex = a.elbow_flexion_deg.to_radians() + 0.5 * soft_positive(flex, ELBOW_BAND);
         pose.set_euler(elbow, Euler::sagittal(elbow_flex));
+    }
+}
+
+/// Half-width of the band of shoulder flexion, rad, over which the elbow's extra flexion
+/// (half of any forward flexion, [`swing_arms`]) starts: `max(flex, 0)` started it at the full
+/// rate where the arm passes the vertical, a kink in the elbow (2 km/h × 1.8 m, the stop's arms
+/// settling: 0 → 0.0042 rad/frame, 2.3 × its neighbours). ≈ 3°: the arm crosses it in 3–10
+/// frames at 1–7 km/h.
+const ELBOW_BAND: f64 = 0.05;
+
+/// `max(x, 0)` with its corner rounded over |x| < `band` by the parabola (x + band)²/(4·band):
+/// C¹, equal to `max(x, 0)` outside the band.
+fn soft_positive(x: f64, band: f64) -> f64 {
+    if x <= -band {
+        0.0
+    } else if x >= band {
+        x
+    } else {
+        (x + band).powi(2) / (4.0 * band)
     }
 }
 
@@ -1681,7 +1700,7 @@ const ARM_LAG_CYCLE: f64 = 0.1;
 /// first-order stages, each delaying the stride's fundamental by half of [`ARM_LAG_CYCLE`]
 /// (continuous time: τ = tan(π·ARM_LAG_CYCLE)·cycle/2π, 45 ms at 7 km/h × 1.5 m, 130 ms at
 /// 1 km/h × 1.8 m), with the gain the two stages take from the fundamental, cos²(π·ARM_LAG_CYCLE)
-/// = 0.905, given back ([`ArmLag::gain`]).
+/// = 0.905, given back (`ArmLag::gain`).
 ///
 /// Why: the arm is a pendulum driven at the shoulder, not welded to the leg, and the leg's rate
 /// changes within a frame or two at heel strike (the swing leg stops flexing and lands
@@ -1734,10 +1753,10 @@ impl ArmLag {
     }
 
     /// The arm's gain on its lagged leg angle: what the two stages take from the stride's
-    /// fundamental given back, fading to 1 with the lag.
-    fn gain(&self) -> f64 {
-        let g = 1.0 / (PI * ARM_LAG_CYCLE).cos().powi(2);
-        g + (1.0 - g) * self.settle
+    /// fundamental, given back. Constant (through the stop's closing too): a gain that changed
+    /// with the lag's fade would move the arm while the legs stand still.
+    fn gain() -> f64 {
+        1.0 / (PI * ARM_LAG_CYCLE).cos().powi(2)
     }
 
     /// Advances `side`'s arm by one frame towards the opposite leg's angle `leg`.
@@ -2032,6 +2051,25 @@ fn first_toe_off_knee(
 mod tests {
     use super::*;
 
+    #[test]
+    fn soft_positive_is_max_with_a_c1_corner() {
+        let b = ELBOW_BAND;
+        for x in [-1.0, -b, b, 0.3] {
+            assert!((soft_positive(x, b) - x.max(0.0)).abs() < 1e-15, "{x}");
+        }
+        // Value and slope continuous at the band's edges, monotone inside.
+        let h = 1e-7;
+        for e in [-b, b] {
+            let left = (soft_positive(e, b) - soft_positive(e - h, b)) / h;
+            let right = (soft_positive(e + h, b) - soft_positive(e, b)) / h;
+            assert!(
+                (left - right).abs() < 1e-5,
+                "slope at {e}: {left} vs {right}"
+            );
+        }
+        assert!((soft_positive(0.0, b) - b / 4.0).abs() < 1e-15);
+    }
+
     /// The arm lag is two equal first-order stages, per arm; faded out (`settle` = 1) the arm
     /// copies the leg.
     #[test]
@@ -2067,7 +2105,6 @@ mod tests {
             assert_eq!(lag.follow(Side::Right, -0.5), -0.5);
             lag.settle = 1.0;
             assert!((lag.follow(Side::Left, 0.3) - 0.3).abs() < 1e-15);
-            assert_eq!(lag.gain(), 1.0);
         }
     }
 
@@ -2085,7 +2122,7 @@ mod tests {
                 let m = cycle * fps;
                 let n = (8.0 * m) as usize;
                 let out: Vec<f64> = (0..n)
-                    .map(|i| lag.gain() * lag.follow(Side::Left, (om * i as f64 / fps).sin()))
+                    .map(|i| ArmLag::gain() * lag.follow(Side::Left, (om * i as f64 / fps).sin()))
                     .collect();
                 // The last whole cycles: the output's fit a·sin + b·cos.
                 let k = (3.0 * m).floor() as usize;
