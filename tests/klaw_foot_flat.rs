@@ -72,12 +72,15 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
 /// off 9–28 frames before midstance). With the projected lock (Froude 0.24–0.65,
 /// `generate::PROJECTED_LOCK_FROUDE_MIN`/`MAX`): ≤ 0.01 mm at 3–6 km/h and 7 km/h × 2.0 m.
 /// Above Froude 0.65 (7 km/h × 1.5/1.8 m) the drawn midstance knee takes the 3-D reach
-/// instead (`StanceSpec::flat_reach`): 4.24/5.14 → 0.00 mm. The walks below Froude 0.24 keep
-/// the hover (1–2 km/h 2.3–5.5 mm): asserted above 1 mm so that a fix there is noticed.
+/// instead (`StanceSpec::flat_reach`): 4.24/5.14 → 0.00 mm. 2 km/h (Froude 0.19–0.21) locks at
+/// the projected length with the leg spring's rest length shortened
+/// (`generate::REST_SHORTENING_FROUDE_MAX`, `StanceSpec::rest_length`): 3.97/4.89/5.53 → 0.00/0.04/0.29 mm
+/// (0.39/0.41/0.77 with the lock alone). The walks below Froude 0.16 (1 km/h) keep the hover
+/// (2.3–3.5 mm): asserted above 1 mm so that a fix there is noticed.
 ///
-/// Where the heel stays down it rises (1 mm) at 37–43 % of the gait cycle (3 km/h 37–39 %,
-/// 5 km/h 40–42 %, 7 km/h 41–43 %): a human's heel off is at 30–40 %, so up to 3 % late at
-/// 5–7 km/h; asserted within 30–45 %. The hovering walks' heels are 1 mm up at 5–8 %.
+/// Where the heel stays down it rises (1 mm) at 34–43 % of the gait cycle (2 km/h 34–37 %,
+/// 3 km/h 37–39 %, 5 km/h 39–42 %, 7 km/h 41–43 %): a human's heel off is at 30–40 %, so up to
+/// 3 % late at 5–7 km/h; asserted within 30–45 %. The hovering walks' heels are 1 mm up at 5–8 %.
 #[test]
 fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
     let mut failed = Vec::new();
@@ -93,7 +96,7 @@ fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
                 100.0 * rise[0],
                 100.0 * rise[1]
             );
-            let fixed = kmh >= 3.0;
+            let fixed = kmh >= 2.0;
             // Where the heel stays down, it rises where a human's does (30–40 % of the
             // cycle), a little late at speed.
             let timed = rise[0] >= 0.30 && rise[1] <= 0.45;

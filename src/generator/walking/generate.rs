@@ -297,22 +297,32 @@ fn num_err(stage: String, message: String) -> GenerateError {
 }
 
 /// Froude speed `v/√(g·l1)` from which the stance leg locks at the sagittal projection of the
-/// drawn 3-D leg (`StanceSpec::lock_reach`; ≈ 2.6 km/h at 1.8 m).
+/// drawn 3-D leg (`StanceSpec::lock_reach`; ≈ 1.7 km/h at 1.8 m), below
+/// [`REST_SHORTENING_FROUDE_MAX`] with the leg spring's rest length shortened as well.
 ///
-/// Why not below: at 1–2 km/h the planned heel rocker lands the knee nearly straight and the
-/// eased knee (`virtual_leg::KNEE_EASE`) rolls the foot from foot flat on; with the lower hip
-/// the landing knee jumped (measured, 8 steps: 1 km/h × 2.0 m 4.65 → 111 at foot flat, 2 km/h ×
-/// 1.5 m 4.0 → 10.6 at heel strike), so those walks keep the paper's lock.
+/// Why not below (1–1.5 km/h; measured, 8 steps, with the shortened rest length ramped in over
+/// 10 % of the stance): the 1 km/h ×
+/// 1.5 m walk's landing knee jumped (4.24 → 9.08, frame 688, l_knee) and gaitfit's default
+/// (foot-speed) double support at 1.5 km/h × 1.6 m (Froude 0.15) came out +39 ms long against
+/// its 36.6 ms limit (`tests/klaw_events.rs`; +20 ms without: the heel strike is seen earlier
+/// and the toe off later with the lower hip through the double support), so those walks keep
+/// the paper's lock and their stance heel still hovers 2.3–3.5 mm at 1 km/h. The lock alone
+/// (the paper's rest length) does not reach there: the leg lands longer than `l1` and locks
+/// where it turns, above the projected lock ([`super::stance::StanceSpec::rest_length`]). It
+/// was 0.24 (3 km/h walks and up) before the rest length.
+pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.16;
+
+/// Froude speed below which a stance that locks at the projected length
+/// ([`PROJECTED_LOCK_FROUDE_MIN`]) also shortens its leg spring's rest length by the same reach
+/// (`StanceSpec::rest_reach`, ramped in over the first 20 % of the stance and out from its
+/// middle: `stance::REST_RAMP_IN`/`REST_RAMP_OUT`).
 ///
-/// Why the lower lock cannot reach there (measured, 1 km/h × 1.8 m): the leg lands 12 mm
-/// longer than `l1`, turns 1 mm short of it ≈ 0.1 s into the stance and locks where it turns,
-/// 4 mm above the projected lock; only a shorter spring rest length lowers it. That fixes
-/// 2 km/h (heel ≤ 0.34 mm; 1 km/h 0.6–1.9 mm) but moves gaitfit's default
-/// (foot-speed) double support at 1.5 km/h × 1.6 m from +23 to +40 ms: the heel strike is
-/// seen 9.5 ms earlier (the swing heel slows to 0.19 m/s 1 cm above the floor 9 frames before
-/// contact, under the 0.5 × walking speed threshold) and the toe off 6 ms later (the toe
-/// leaves at 0.33 instead of 0.42 m/s), so the walks below keep the hover.
-pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.24;
+/// Why: at 2 km/h (Froude 0.19–0.21) the projected lock alone left the stance heel 0.4–0.8 mm
+/// up, with the rest length ≤ 0.29 mm (2.3–5.5 mm before either; `tests/klaw_foot_flat.rs`).
+/// Why not above: there the lock alone keeps the heel down, and the shorter rest length
+/// (kept to the end of the stance) raised 3 km/h × 1.5/2.0 m's worst continuity ratio
+/// 3.32/3.13 → 4.09/3.72 (landing knees).
+pub const REST_SHORTENING_FROUDE_MAX: f64 = 0.24;
 
 /// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m);
 /// above it the drawn knee takes the same reach instead (`StanceSpec::flat_reach`, through
@@ -663,6 +673,7 @@ pub fn generate_steps(
             lock_short: 0.0,
             lock_reach: 0.0,
             flat_reach: 0.0,
+            rest_reach: 0.0,
         };
         // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
         let lock_short = super::stance::lock_shortening(spec.push_off);
@@ -680,15 +691,17 @@ pub fn generate_steps(
         let lock_full = body.l1 * (1.0 - lock_short);
         let lock_flat = lock_full - 2.0 * KNEE_SOFT - STAND_MARGIN;
         let flat_reach = lock_full - (lock_flat * lock_flat - dz_max * dz_max).max(0.0).sqrt();
-        // Where the lock is not shortened by it, the drawn knee takes it (`drawn_span`).
+        // Where the lock is not shortened by it, the drawn knee takes it (`drawn_span`); in
+        // slow walks the spring's rest length is shortened by it as well
+        // (`REST_SHORTENING_FROUDE_MAX`).
+        let projected = projected_lock(l.speed_m_per_s, body.l1, from_rest || to_rest);
+        let slow =
+            super::stance::froude_speed(l.speed_m_per_s, body.l1) < REST_SHORTENING_FROUDE_MAX;
         let spec = StanceSpec {
             lock_short,
-            lock_reach: if projected_lock(l.speed_m_per_s, body.l1, from_rest || to_rest) {
-                flat_reach
-            } else {
-                0.0
-            },
+            lock_reach: if projected { flat_reach } else { 0.0 },
             flat_reach,
+            rest_reach: if projected && slow { flat_reach } else { 0.0 },
             ..spec
         };
         let (st_solved, st_run) = spec

@@ -163,7 +163,23 @@ pub struct StanceSpec {
     /// must be shortened by ([`StanceSpec::lock_reach`]), or the drawn span lengthened by
     /// ([`StanceSpec::drawn_span`]), for the flat foot to stay within reach (0: none).
     pub flat_reach: f64,
+    /// How much shorter than `l1` the leg spring's rest length is through the stance's first
+    /// half, m (0: the paper's rest length `l1`; see [`StanceSpec::rest_length`]).
+    pub rest_reach: f64,
 }
+
+/// Fraction of the stance over which the leg spring's shortened rest length ramps in from
+/// heel strike ([`StanceSpec::rest_length`]). Measured against 0.1 (2 km/h, 8 steps): the heel
+/// ≤ 0.29 mm against 0.00 mm, but the knee a few frames after foot flat 2.9/2.8/2.7 against
+/// 3.5/2.9/2.8 at 1.5/1.8/2.0 m, and from standing at 1.5 m 2.9 against 3.6.
+pub const REST_RAMP_IN: f64 = 0.2;
+
+/// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by
+/// the end of the stance ([`StanceSpec::rest_length`]): the next heel strike meets the hip
+/// where the paper's spring puts it, so a change of speed into a walk without the shortening
+/// lands as before (with the rest length kept short to the end, a 2 → 3.5 km/h step of a
+/// 1.5 m body from standing jumped at the landing knee: 4.12 → 8.2).
+pub const REST_RAMP_OUT: f64 = 0.5;
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
 /// a 1.8 m body, `l1` ≈ 0.87 m).
@@ -260,7 +276,8 @@ impl StanceSpec {
     /// (flat only up to `l − 2σ`) the flat foot rolled onto its ball: the heel hovered ≈ 5 mm
     /// up from foot flat to heel off. The rigid leg here is the sagittal projection of the 3-D
     /// leg with that soft knee (`lock_reach`, set by the generator from the stance's largest
-    /// `dz`, at Froude speeds 0.24–0.65: `generate::PROJECTED_LOCK_FROUDE_MIN`), so the stance
+    /// `dz`, at Froude speeds 0.16–0.65: `generate::PROJECTED_LOCK_FROUDE_MIN`; below 0.24 with
+    /// the spring's rest length shortened too, [`StanceSpec::rest_length`]), so the stance
     /// heel stays down until the extension lifts it. Above that speed the drawn knee takes the
     /// same reach instead ([`StanceSpec::drawn_span`]).
     pub fn lock_length(&self) -> f64 {
@@ -319,6 +336,22 @@ impl StanceSpec {
     /// RK4 stage of the segment ending at `torque_off` is evaluated at `t + h`, which rounds to
     /// either side of the switch, and a torque read from `t` there made `θ̇1` jump by `h·A/(6I)`
     /// (a discontinuous shooting residual that stalled the solver, issue 6 / klawfix).
+    /// The leg spring's rest length at stance time `t`, m: `l1` shortened by
+    /// [`StanceSpec::rest_reach`] (smoothstep in over the first [`REST_RAMP_IN`] of the
+    /// stance, out again from [`REST_RAMP_OUT`] to its end).
+    ///
+    /// Not in the paper (its spring rests at `l1`). Why: in slow walks the leg lands longer than
+    /// `l1` (1 km/h × 1.8 m: 12 mm) and turns about 0.1 s into the stance within a millimetre of
+    /// `l1`, above any shortened lock, so the rigid leg locks where it turns and the drawn 3-D
+    /// leg cannot reach its flat foot: the stance heel hovered 4–5.5 mm through midstance at
+    /// 2 km/h. Only a shorter rest length lowers the hip there (klawflat3, session 7).
+    pub fn rest_length(&self, t: f64) -> f64 {
+        let d = self.duration.max(1e-9);
+        let on = smoothstep((t / (REST_RAMP_IN * d)).clamp(0.0, 1.0));
+        let off = smoothstep(((t / d - REST_RAMP_OUT) / (1.0 - REST_RAMP_OUT)).clamp(0.0, 1.0));
+        self.l1 - self.rest_reach.max(0.0) * on * (1.0 - off)
+    }
+
     fn forces(&self, t: f64, y: &[f64; 7], f1: f64, sub: Sub, ext: (f64, f64, f64)) -> [f64; 3] {
         let f2 = -self.k2 * (y[2] - self.theta2_ref) - self.c2 * y[5];
         let pa = match sub {
@@ -329,7 +362,7 @@ impl StanceSpec {
             }
             _ => y[6],
         };
-        let fw = self.k_w * (self.l1 + pa - y[0]) - self.v_w * y[3];
+        let fw = self.k_w * (self.rest_length(t) + pa - y[0]) - self.v_w * y[3];
         [fw, f1, f2]
     }
 
@@ -445,7 +478,8 @@ impl StanceSpec {
                         let q = [y[0], y[1], y[2]];
                         let qd = [y[3], y[4], y[5]];
                         let f = self.forces(t, &y, f1, sub, ext);
-                        self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
+                        self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0]
+                            - self.rest_length(t)
                     } else {
                         y[6]
                     };
@@ -606,6 +640,7 @@ mod tests {
             lock_short: 0.0,
             lock_reach: 0.0,
             flat_reach: 0.0,
+            rest_reach: 0.0,
         };
         let start = StanceStart {
             q: [
@@ -761,6 +796,49 @@ mod tests {
         assert!(wd4 > wd2 + 0.05, "ẇ(t_step) {wd2} → {wd4}");
         assert!(vy4 > vy2 + 0.02, "hip vertical velocity {vy2} → {vy4}");
         assert_eq!(push_off_exponent(0.5, 0.87), 2.0);
+    }
+
+    #[test]
+    fn a_shortened_rest_length_ramps_in_and_out_and_lowers_the_hip() {
+        let (spec, start) = grazing_spec();
+        let d = spec.duration;
+        let short = StanceSpec {
+            rest_reach: 0.01,
+            ..spec
+        };
+        // The paper's rest length without a reach; l1 − reach from REST_RAMP_IN to
+        // REST_RAMP_OUT of the stance, l1 at both ends, monotone in between.
+        for i in 0..=100 {
+            let t = d * i as f64 / 100.0;
+            assert_eq!(spec.rest_length(t), spec.l1);
+            let f = i as f64 / 100.0;
+            let r = short.rest_length(t);
+            if (REST_RAMP_IN..=REST_RAMP_OUT).contains(&f) {
+                assert!((r - (spec.l1 - 0.01)).abs() < 1e-12, "{f}: {r}");
+            }
+            if i > 0 {
+                let before = short.rest_length(d * (i - 1) as f64 / 100.0);
+                let falling = f <= REST_RAMP_OUT;
+                assert!(if falling { r <= before } else { r >= before }, "{f}");
+            }
+        }
+        assert_eq!(short.rest_length(0.0), spec.l1);
+        assert!((short.rest_length(d) - spec.l1).abs() < 1e-12);
+        // The spring rests shorter, so the leg is compressed further before it locks (2.3 mm at
+        // 15 % of this stance).
+        let h = spec.step(&start);
+        let r0 = spec.run(&start, 60.0, 0.0, h, true);
+        let r1 = short.run(&start, 60.0, 0.0, h, true);
+        let w = |r: &StanceRun, f: f64| r.track.at(f * d).0[0];
+        assert!(
+            w(&r1, 0.15) < w(&r0, 0.15) - 1.5e-3,
+            "{} vs {}",
+            w(&r1, 0.15),
+            w(&r0, 0.15)
+        );
+        // This leg regains its lock from below either way: it locks later, at the same length.
+        assert!(r1.lock_time.unwrap_or(0.0) > r0.lock_time.unwrap_or(f64::INFINITY));
+        assert!((w(&r1, 0.5) - w(&r0, 0.5)).abs() < 1e-3);
     }
 
     #[test]
