@@ -78,8 +78,17 @@ pub const KNEE_EASE_SOFT: f64 = 0.00033;
 /// ([`KNEE_EASE_SOFT`]) on or off against the shortest's is not taken (1 km/h × 1.5 m 4.6 →
 /// 6.9 otherwise), unless the kept one's knee leaves heel strike at ≥ 2 × its mean rate (1 → 7
 /// km/h × 2.0 m 26.85 → 4.58 with the exception) or flexes, straightens and flexes again inside
-/// the rocker (the first slower step of a slow-down: 3 → 1 km/h × 1.8 m 10.6 → 4.2).
+/// the rocker and the other is [`DIP_TRADE`] × gentler (the first slower step of a slow-down:
+/// 3 → 1 km/h × 1.8 m 10.6 → 4.2).
 pub const ROCKER_SCAN: usize = 4;
+
+/// How much gentler (peak knee acceleration, [`ROCKER_SCAN`]'s cost) a landing must be to replace
+/// a kept landing whose knee dips (flexes, straightens and flexes again) against the knee-ease
+/// rule there. Why: the first slower stance of a slow-down trades a dipping eased landing for one
+/// 21–700 × gentler (3 → 1 km/h × 1.8 m 10.6 → 4.2); steady 1 km/h walks at 1.7 m have a
+/// shallower dip with a landing only 5.3 × gentler, and trading it made their knee straighten
+/// abruptly at heel off (6.0 → 7.35).
+pub const DIP_TRADE: f64 = 10.0;
 
 /// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow):
 /// the meta-off knee blend ends at this rate instead of at rest.
@@ -647,6 +656,7 @@ impl VirtualLeg {
         let mut best: Option<(f64, HeelRocker, f64, f64)> = None;
         let mut left = usize::MAX;
         let mut best_fast = false;
+        let mut best_dips = false;
         for _ in 0..30 {
             let kt = samples.partition_point(|s| s.0 < t_first + duration);
             if left == 0 || kt + 1 >= samples.len() {
@@ -745,10 +755,14 @@ impl VirtualLeg {
             // the faster step's steeper heel-strike pitch; its shortest, eased landing must meet
             // the flat foot's knee at 5 × its mean rate, 5–9 rad/s, and the knee flexed 0.012 rad
             // in the first frame, straightened and surged 0.2 rad at foot flat: 3 → 1 km/h ×
-            // 1.8 m 10.6, 2 → 1 km/h × 1.8 m 7.9, 1.5 → 1 km/h × 2.0 m 6.2 → 4.2, 4.0, 4.8).
-            let fast = best.is_some() && best_fast;
+            // 1.8 m 10.6, 2 → 1 km/h × 1.8 m 7.9, 1.5 → 1 km/h × 2.0 m 6.2 → 4.2, 4.0, 4.8) and
+            // the new landing is at least `DIP_TRADE` × gentler.
+            let fast = best
+                .as_ref()
+                .is_some_and(|b| best_fast || (best_dips && cost * DIP_TRADE <= b.0));
             if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
-                best_fast = f >= 2.0 || knee_dips(k_end, big_t, r0, k_rate);
+                best_fast = f >= 2.0;
+                best_dips = knee_dips(k_end, big_t, r0, k_rate);
                 best = Some((cost, HeelRocker { end, table }, landing, soft));
             }
             left = left.min(scan + 1) - 1;
