@@ -8,34 +8,11 @@
 //! the 3 steps on either side, floors 1e-4 m and 1e-3 rad), restricted to the swing leg's ankle
 //! centre and knee rotation over swing1 (toe off to `swing1_end` = 50 % of the swing).
 use gaitfit::events::{EventKind, Side};
-use gaitfit::generator::checks::ContinuityOptions;
+use gaitfit::generator::checks::{rotation_angle, step_ratios, ContinuityOptions};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::{Joint, Landmark};
 use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 use proptest::prelude::*;
-
-/// Ratio of each step to the median of the `w` steps on either side (at least `floor`).
-fn ratios(steps: &[f64], floor: f64, w: usize) -> Vec<f64> {
-    (0..steps.len())
-        .map(|i| {
-            let lo = i.saturating_sub(w);
-            let hi = (i + w + 1).min(steps.len());
-            let mut v: Vec<f64> = steps[lo..i]
-                .iter()
-                .chain(&steps[i + 1..hi])
-                .copied()
-                .collect();
-            v.sort_by(f64::total_cmp);
-            let m = v.len();
-            let med = if m % 2 == 1 {
-                v[m / 2]
-            } else {
-                0.5 * (v[m / 2 - 1] + v[m / 2])
-            };
-            steps[i] / med.max(floor)
-        })
-        .collect()
-}
 
 /// The worst ratio of the swing leg's ankle and knee steps over every swing1 of `m`, with a
 /// description of where.
@@ -58,13 +35,17 @@ fn swing1_worst(m: &Motion) -> (f64, String) {
         let knee_steps: Vec<f64> = m
             .poses()
             .windows(2)
-            .map(|p| {
-                let r = p[0].rotations[ki].conjugate() * p[1].rotations[ki];
-                2.0 * r.xyz().length().atan2(r.w.abs())
-            })
+            .map(|p| rotation_angle(p[0].rotations[ki], p[1].rotations[ki]))
             .collect();
-        let ra = ratios(&ankle_steps, o.floor_m, o.window);
-        let rk = ratios(&knee_steps, o.floor_rad, o.window);
+        // `checks::continuity`'s own ratios (a step without neighbours counts as 0).
+        let ratios = |steps: &[f64], floor| -> Vec<f64> {
+            step_ratios(steps, o.window, floor)
+                .into_iter()
+                .map(|r| r.unwrap_or(0.0))
+                .collect()
+        };
+        let ra = ratios(&ankle_steps, o.floor_m);
+        let rk = ratios(&knee_steps, o.floor_rad);
         let mine: Vec<_> = m.events.iter().filter(|e| e.side == side).collect();
         for (i, e) in mine.iter().enumerate() {
             if e.kind != EventKind::ToeOff {

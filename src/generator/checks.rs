@@ -295,25 +295,18 @@ pub fn continuity_over(
         return w.report("continuity", "ratio", options.k, true);
     }
     let mut steps = vec![0.0; n - 1];
-    let mut scratch = Vec::with_capacity(2 * options.window);
-    let mut scan = |steps: &[f64], floor: f64, name: &str, w: &mut Worst| {
-        for i in frames.start..frames.end.min(steps.len()) {
-            scratch.clear();
-            let lo = i.saturating_sub(options.window);
-            let hi = (i + options.window + 1).min(steps.len());
-            scratch.extend(steps[lo..i].iter().chain(steps[i + 1..hi].iter()));
-            if scratch.is_empty() {
-                continue;
+    let scan = |steps: &[f64], floor: f64, name: &str, w: &mut Worst| {
+        let ratios = step_ratios(steps, options.window, floor);
+        for (i, r) in ratios
+            .iter()
+            .enumerate()
+            .take(frames.end)
+            .skip(frames.start)
+        {
+            if let Some(r) = *r {
+                w.examined += 1;
+                w.max(r, i, || name.to_string());
             }
-            scratch.sort_by(f64::total_cmp);
-            let m = scratch.len();
-            let median = if m % 2 == 1 {
-                scratch[m / 2]
-            } else {
-                0.5 * (scratch[m / 2 - 1] + scratch[m / 2])
-            };
-            w.examined += 1;
-            w.max(steps[i] / median.max(floor), i, || name.to_string());
         }
     };
     for l in 0..LANDMARK_COUNT {
@@ -334,8 +327,37 @@ pub fn continuity_over(
     w.report("continuity", "ratio", options.k, passed)
 }
 
-/// Angle of the rotation taking `a` to `b`, rad, in [0, π].
-fn rotation_angle(a: DQuat, b: DQuat) -> f64 {
+/// The measure behind [`continuity`] for one channel's frame-to-frame `steps`: each step's
+/// ratio to the median of the `window` steps on either side of it (the median at least
+/// `floor`). `None` for a step without neighbours (a motion of two frames), which
+/// [`continuity`] does not examine. For a check restricted to chosen channels (e.g. the swing
+/// leg's ankle and knee) build their steps with [`Landmark`] distances or [`rotation_angle`].
+pub fn step_ratios(steps: &[f64], window: usize, floor: f64) -> Vec<Option<f64>> {
+    let mut scratch = Vec::with_capacity(2 * window);
+    (0..steps.len())
+        .map(|i| {
+            scratch.clear();
+            let lo = i.saturating_sub(window);
+            let hi = (i + window + 1).min(steps.len());
+            scratch.extend(steps[lo..i].iter().chain(steps[i + 1..hi].iter()));
+            if scratch.is_empty() {
+                return None;
+            }
+            scratch.sort_by(f64::total_cmp);
+            let m = scratch.len();
+            let median = if m % 2 == 1 {
+                scratch[m / 2]
+            } else {
+                0.5 * (scratch[m / 2 - 1] + scratch[m / 2])
+            };
+            Some(steps[i] / median.max(floor))
+        })
+        .collect()
+}
+
+/// Angle of the rotation taking `a` to `b`, rad, in [0, π]: a joint's frame-to-frame step in
+/// [`continuity`].
+pub fn rotation_angle(a: DQuat, b: DQuat) -> f64 {
     // atan2 form: accurate for tiny angles, where acos(w) loses half the digits.
     let r = a.conjugate() * b;
     2.0 * r.xyz().length().atan2(r.w.abs())
