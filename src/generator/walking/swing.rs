@@ -1221,38 +1221,20 @@ pub fn knee_on_circle(k: [f64; 2], l4: f64, th3: f64, curve: &AnkleCurve, guess:
         let (y, dy) = curve.eval(ax);
         (k[1] - l4 * c - y, l4 * (s + dy * c), ax, s, c, dy)
     };
-    let mut th4 = guess;
-    for _ in 0..30 {
-        let (f, df, ..) = res(th4);
-        if df.abs() < 1e-12 {
-            break;
-        }
-        let step = (f / df).clamp(-0.2, 0.2);
-        th4 -= step;
-        if step.abs() < 1e-14 {
-            break;
-        }
-    }
+    let (th4, _) = damped_newton(guess, 0.2, |t| {
+        let (f, df, ..) = res(t);
+        (f, df)
+    });
     let (f, df, ..) = res(th4);
     if f.abs() < 1e-9 && df > 0.0 && (th4 - guess).abs() <= KNEE_BRANCH_STEP {
         return th4;
     }
     // Newton missed the branch (near a fold it can overshoot onto the partner root). The
     // extremum of F next to `guess`: Newton on ∂F/∂θ4 = l4·(s + P'·c) = 0.
-    let mut ext = guess;
-    let mut curv = 0.0;
-    for _ in 0..30 {
-        let (_, g, ax, s, c, dy) = res(ext);
-        curv = l4 * (c - dy * s - l4 * c * c * curve.curvature(ax));
-        if curv.abs() < 1e-12 {
-            break;
-        }
-        let step = (g / curv).clamp(-0.05, 0.05);
-        ext -= step;
-        if step.abs() < 1e-14 {
-            break;
-        }
-    }
+    let (ext, curv) = damped_newton(guess, 0.05, |e| {
+        let (_, g, ax, s, c, dy) = res(e);
+        (g, l4 * (c - dy * s - l4 * c * c * curve.curvature(ax)))
+    });
     let (fe, g, ..) = res(ext);
     if !(g.abs() < 1e-9 && ext.is_finite() && (ext - guess).abs() <= KNEE_BRANCH_STEP) {
         return guess;
@@ -1294,6 +1276,26 @@ pub fn knee_on_circle(k: [f64; 2], l4: f64, th3: f64, curve: &AnkleCurve, guess:
     } else {
         ext
     }
+}
+
+/// Damped Newton for a root of `f` (value, derivative) from `x`, each step at most `max_step`
+/// (at most 30 steps; stops on a vanishing derivative or a step under 1e-14). Returns the last
+/// iterate and the derivative last evaluated.
+fn damped_newton(mut x: f64, max_step: f64, f: impl Fn(f64) -> (f64, f64)) -> (f64, f64) {
+    let mut d = 0.0;
+    for _ in 0..30 {
+        let (v, dv) = f(x);
+        d = dv;
+        if dv.abs() < 1e-12 {
+            break;
+        }
+        let step = (v / dv).clamp(-max_step, max_step);
+        x -= step;
+        if step.abs() < 1e-14 {
+            break;
+        }
+    }
+    (x, d)
 }
 
 /// Largest change of the slaved swing1 knee between two evaluations of [`knee_on_circle`]
