@@ -22,31 +22,19 @@
 //! worse. Before this work: 263 at 5 km/h, 1568 on the standing-start schedule.
 //!
 //! Tighten the bounds when a fix lands; move a walk to the `passed` list when it meets k = 5.
+mod common;
+
+use common::{joint_angles, joint_steps};
 use gaitfit::events::EventKind;
 use gaitfit::generator::checks::{continuity, continuity_over, ContinuityOptions};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::Joint;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
+use gaitfit::generator::walking::generate_walk;
 
+/// The worst continuity ratio (k = 5, the whole walk) of schedule `sched` at height `h`, steady
+/// or from standing with a stop, and the report.
 fn worst(sched: &[(f64, usize)], h: f64, rest_and_stop: bool) -> (f64, String) {
-    let schedule: Vec<ScheduleEntry> = sched
-        .iter()
-        .map(|&(kmh, steps)| ScheduleEntry::at_speed(kmh / 3.6, steps))
-        .collect();
-    let opts = WalkOptions {
-        height_m: h,
-        start_from_rest: rest_and_stop,
-        stop: rest_and_stop,
-        ..Default::default()
-    };
-    let (m, _) = generate_walk(&schedule, &opts).unwrap();
-    let r = continuity(&m, &ContinuityOptions::default());
-    assert!(
-        r.examined > 1000,
-        "{sched:?}: {} steps examined",
-        r.examined
-    );
-    (r.worst, format!("{r}"))
+    common::worst_ratio(&common::walk(sched, h, rest_and_stop, rest_and_stop).0)
 }
 
 /// Where KLAW meets k = 5 today (8 steps, steady start): the check itself must pass.
@@ -104,12 +92,7 @@ fn continuity_is_met_at_1_to_7_kmh() {
 #[test]
 fn fast_short_heel_strikes_do_not_regress() {
     let o = ContinuityOptions::default();
-    let schedule = [ScheduleEntry::at_speed(7.0 / 3.6, 8)];
-    let opts = WalkOptions {
-        height_m: 1.5,
-        ..Default::default()
-    };
-    let (m, _) = generate_walk(&schedule, &opts).unwrap();
+    let (m, _) = common::steady(7.0, 1.5, 8);
     let r = continuity(&m, &o);
     println!("7 km/h 1.5 m: {r}");
     assert!(r.examined > 1000, "{} examined", r.examined);
@@ -175,18 +158,6 @@ const BOUND_7KMH: f64 = 5.0; // measured 4.01 (frame 5, l_ankle, since the conta
 // 5.32 → 4.61 (frame 348, r_ankle): asserted there; 6 km/h × 2.0 m 4.24 → 3.60.
 const BOUND_SCHEDULE: f64 = 4.36; // meets k = 5: measured 3.49 (frame 100, r_knee, the start, since the first swing from standing is braked and bell-shaped, klawstart2); 3.70 (frame 100, r_knee, the start, since the default speed-change limit ramps 2 -> 3.5 -> 5 -> 4 -> 3 km/h, `max_speed_change_m_per_s` = 0.5); 4.71 (frame 865, l_ankle, since the stop's swings are braked; 6.08 at 851, l_knee, the unbraked last swing's knee at its lock, before); 6.08 (frame 851, l_knee, the stop's last swing, since the speed-up's push-off, `generate::speeds_up`; 6.20 at 362, r_knee, the trailing knee of the first 5 km/h step, before); 5.73 (frame 520, r_ankle, a 5 km/h heel strike; 7.23 before the push-off; 8.63 at frame 176, l_knee, and 12.6 at frame 144, l_toe, the first swing from standing, before the full first step and the lift's speed floor)
 
-/// Frame-to-frame rotation (rad) of `joint`'s local rotation, as `checks::continuity` measures it.
-fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
-    let ji = joint.index();
-    m.poses()
-        .windows(2)
-        .map(|p| {
-            let r = p[0].rotations[ji].conjugate() * p[1].rotations[ji];
-            2.0 * r.xyz().length().atan2(r.w.abs())
-        })
-        .collect()
-}
-
 /// The mechanism of the heel-strike fix (klawhs): the landing ankle enters the contact already
 /// plantarflexing at the stance foot's early rate (bounded by `MAX_CONTACT_ANKLE_RATE`), instead
 /// of arriving at rest and rolling at 8–15 rad/s the next frame. Pinned at 5 and 7 km/h: the
@@ -200,8 +171,7 @@ fn joint_steps(m: &Motion, joint: Joint) -> Vec<f64> {
 fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
     let rate = gaitfit::generator::walking::generate::MAX_CONTACT_ANKLE_RATE;
     for (kmh, bound) in [(5.0, HS_ANKLE_5KMH), (7.0, HS_ANKLE_7KMH)] {
-        let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-        let (m, _) = generate_walk(&schedule, &WalkOptions::default()).unwrap();
+        let (m, _) = common::steady(kmh, 1.8, 8);
         let fps = m.fps();
         let mut seen = (f64::INFINITY, 0.0f64);
         for (f, side) in contact_frames(&m) {
@@ -245,12 +215,7 @@ fn landing_ankle_is_already_plantarflexing_at_heel_strike() {
 #[test]
 fn the_arms_do_not_jolt_at_heel_strike() {
     for h in [1.5, 1.8, 2.0] {
-        let schedule = [ScheduleEntry::at_speed(7.0 / 3.6, 8)];
-        let opts = WalkOptions {
-            height_m: h,
-            ..Default::default()
-        };
-        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let (m, _) = common::steady(7.0, h, 8);
         let mut worst: f64 = 0.0;
         for j in [1, 2] {
             for opposite in [false, true] {
@@ -279,20 +244,8 @@ const HS_ANKLE_7KMH: f64 = 1.25 * 4.01; // since the contact ramp (6.42 bound be
 /// A walk of 6 steps at `kmh` and height `h` that ends in a stop (from standing if `rest`), and
 /// its heel strikes as fractional frame numbers.
 fn six_steps_to_a_stop(kmh: f64, h: f64, rest: bool) -> (Motion, Vec<f64>) {
-    let opts = WalkOptions {
-        height_m: h,
-        start_from_rest: rest,
-        stop: true,
-        ..Default::default()
-    };
-    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 6)];
-    let (m, _) = generate_walk(&schedule, &opts).unwrap();
-    let hs = m
-        .events
-        .iter()
-        .filter(|e| e.kind == EventKind::HeelStrike)
-        .map(|e| e.time_s * m.fps())
-        .collect();
+    let (m, _) = common::walk(&[(kmh, 6)], h, rest, true);
+    let hs = common::heel_strike_frames(&m);
     (m, hs)
 }
 
@@ -416,18 +369,6 @@ fn walks_from_standing_meet_k5() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// Knee flexion (rad) of `joint`'s local rotation per frame: its rotation angle.
-fn joint_angles(m: &Motion, joint: Joint) -> Vec<f64> {
-    let ji = joint.index();
-    m.poses()
-        .iter()
-        .map(|p| {
-            let r = p.rotations[ji];
-            2.0 * r.xyz().length().atan2(r.w.abs())
-        })
-        .collect()
-}
-
 /// The trailing knee flexes steadily through the double support (klawfirst2, `hold_knees`): from
 /// each heel strike to the other foot's toe off it never straightens by more than 1 mrad in a
 /// frame (the continuity floor; measured ≤ 0.46 mrad). It used to straighten by 0.01 rad in the frame after heel strike (≈ 1 rad/s, undoing
@@ -439,28 +380,16 @@ fn the_trailing_knee_does_not_straighten_in_double_support() {
     let mut failures = Vec::new();
     for kmh in [3.0, 5.0, 6.0, 7.0] {
         for h in [1.5, 1.8, 2.0] {
-            let opts = WalkOptions {
-                height_m: h,
-                ..Default::default()
-            };
-            let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-            let (m, _) = generate_walk(&schedule, &opts).unwrap();
+            let (m, _) = common::steady(kmh, h, 8);
             let fps = m.fps();
             let mut worst = (0.0f64, 0usize);
             for hs in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
                 let trailing = hs.side.opposite();
-                let Some(to) = m.events.iter().find(|e| {
-                    e.kind == EventKind::ToeOff && e.side == trailing && e.time_s > hs.time_s
-                }) else {
+                let Some(to) = common::next_event(&m, EventKind::ToeOff, trailing, hs.time_s)
+                else {
                     continue;
                 };
-                let knee = joint_angles(
-                    &m,
-                    match trailing {
-                        gaitfit::events::Side::Left => Joint::LKnee,
-                        gaitfit::events::Side::Right => Joint::RKnee,
-                    },
-                );
+                let knee = joint_angles(&m, Joint::leg(trailing)[1]);
                 let (a, b) = (
                     (hs.time_s * fps).floor() as usize,
                     ((to.time_s * fps).floor() as usize).min(knee.len() - 1),
@@ -575,17 +504,7 @@ fn a_large_speed_change_is_ramped_and_stays_continuous() {
     ];
     let mut failures = Vec::new();
     for (h, bound) in cases {
-        let opts = WalkOptions {
-            height_m: h,
-            start_from_rest: true,
-            stop: true,
-            ..Default::default()
-        };
-        let schedule = [
-            ScheduleEntry::at_speed(1.0 / 3.6, 4),
-            ScheduleEntry::at_speed(7.0 / 3.6, 4),
-        ];
-        let (m, report) = generate_walk(&schedule, &opts).unwrap();
+        let (m, report) = common::walk(&[(1.0, 4), (7.0, 4)], h, true, true);
         // The ramp: 3 of the 7 km/h stretch's 4 steps, the last a half step (the stop).
         let kmh: Vec<f64> = report
             .steps
@@ -626,28 +545,14 @@ fn a_speed_up_pushes_off_with_the_trailing_knee() {
     let mut failures = Vec::new();
     for fast in [4.0, 5.0] {
         for h in [1.5, 1.8, 2.0] {
-            let mut opts = WalkOptions {
-                height_m: h,
-                start_from_rest: true,
-                stop: true,
-                ..Default::default()
-            };
+            let mut opts = common::options(h, true, true);
             // The paper's one-step change (0.56 and 0.83 m/s), not the default ramp: this
             // tests the push-off of a large one-step speed-up.
             opts.attributes.max_speed_change_m_per_s = 10.0;
-            let schedule = [
-                ScheduleEntry::at_speed(2.0 / 3.6, 4),
-                ScheduleEntry::at_speed(fast / 3.6, 4),
-            ];
+            let schedule = common::schedule(&[(2.0, 4), (fast, 4)]);
             let (m, report) = generate_walk(&schedule, &opts).unwrap();
             let step = &report.steps[4];
-            let knee = joint_angles(
-                &m,
-                match step.stance_side.opposite() {
-                    gaitfit::events::Side::Left => Joint::LKnee,
-                    gaitfit::events::Side::Right => Joint::RKnee,
-                },
-            );
+            let knee = joint_angles(&m, Joint::leg(step.stance_side.opposite())[1]);
             let fps = m.fps();
             let a = (step.start_s * fps).floor() as usize;
             let b = ((step.start_s + step.times.double_support) * fps).floor() as usize;
@@ -716,18 +621,7 @@ fn contact_ratio(m: &Motion, joint_of: impl Fn(gaitfit::events::Side) -> Joint) 
 #[test]
 fn slow_walk_knee_leaves_heel_strike_from_rest() {
     for h in [1.5, 1.8, 2.0] {
-        let schedule = [ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: Some(1.0 / 3.6),
-                ..Default::default()
-            },
-            steps: 6,
-        }];
-        let opts = WalkOptions {
-            height_m: h,
-            ..Default::default()
-        };
-        let (m, _) = generate_walk(&schedule, &opts).unwrap();
+        let (m, _) = common::steady(1.0, h, 6);
         let (worst, checked) = contact_ratio(&m, |s| Joint::leg(s)[1]);
         println!("1 km/h, {h} m: worst knee ratio over {checked} contacts {worst:.2}");
         assert!(checked >= 4);

@@ -19,22 +19,12 @@
 //!   double support comes back within 3 frames (30 ms) of t_ds at every speed. With the default
 //!   1 cm tolerance the toe, which rises tangentially and is held only 5 mm (the toe-clearance
 //!   attribute) above the ground early in slow swings, is never seen leaving.
-use gaitfit::events::{steps_from_trial, EventOptions, Gait, PrimarySource};
-use gaitfit::generator::motion::Motion;
-use gaitfit::generator::walking::high_level::phase_times;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkReport};
-use gaitfit::ingest::trials::StepRow;
+mod common;
 
-/// A steady walk of `steps` steps at `kmh` and height `h`, with its options and report.
-fn steady_walk(kmh: f64, h: f64, steps: usize) -> (WalkOptions, Motion, WalkReport) {
-    let opts = WalkOptions {
-        height_m: h,
-        ..Default::default()
-    };
-    let sched = [ScheduleEntry::at_speed(kmh / 3.6, steps)];
-    let (m, r) = generate_walk(&sched, &opts).unwrap();
-    (opts, m, r)
-}
+use common::{leg, steady};
+use gaitfit::events::{steps_from_trial, EventOptions, Gait, PrimarySource};
+use gaitfit::generator::walking::high_level::phase_times;
+use gaitfit::ingest::trials::StepRow;
 
 #[test]
 fn detection_recovers_step_length_frequency_and_double_support() {
@@ -54,7 +44,8 @@ fn detection_recovers_step_length_frequency_and_double_support() {
     heights.phases.height_tol_m = 1e-3;
     heights.kinematic.cutoff_hz = 45.0;
     for (kmh, h) in [(1.5, 1.6), (3.0, 1.7), (5.0, 1.8), (7.0, 1.95)] {
-        let (opts, m, r) = steady_walk(kmh, h, 10);
+        let opts = common::options(h, false, false);
+        let (m, r) = steady(kmh, h, 10);
         let sl = r.steps[0].step_length_m;
         let sf = r.steps[0].step_freq_steps_per_min / 60.0;
         let t_ds = phase_times(r.steps[0].step_freq_steps_per_min, &opts.relations).double_support;
@@ -129,10 +120,10 @@ fn detection_recovers_step_length_frequency_and_double_support() {
 /// steps before it is straight shrink; with the paper's single knee torque they grew).
 #[test]
 fn toe_leaves_briskly_and_the_knee_decelerates_into_the_lock() {
-    use gaitfit::events::{EventKind, Side};
-    use gaitfit::generator::skeleton::{Joint, Landmark};
+    use gaitfit::events::EventKind;
+    use gaitfit::generator::skeleton::Joint;
     for (kmh, h) in [(1.5, 1.6), (3.0, 1.7), (5.0, 1.8), (7.0, 1.95)] {
-        let (_, m, _) = steady_walk(kmh, h, 8);
+        let (m, _) = steady(kmh, h, 8);
         let v = kmh / 3.6;
         let fps = m.fps();
         let toe_offs: Vec<_> = m
@@ -146,10 +137,7 @@ fn toe_leaves_briskly_and_the_knee_decelerates_into_the_lock() {
             toe_offs.len()
         );
         for e in &toe_offs {
-            let (toe, knee) = match e.side {
-                Side::Left => (Landmark::LToe, Joint::LKnee),
-                Side::Right => (Landmark::RToe, Joint::RKnee),
-            };
+            let (toe, knee) = (leg(e.side).toe, Joint::leg(e.side)[1]);
             // Frames from the one containing toe off to 50 ms after it.
             let i0 = (e.time_s * fps).floor() as usize;
             let i1 = ((e.time_s + 0.05) * fps).floor() as usize;
@@ -198,7 +186,7 @@ fn a_steady_walk_starts_and_ends_mid_motion() {
     use gaitfit::generator::skeleton::Landmark;
     use gaitfit::generator::walking::generate::{LEAD_IN_FRAMES, LEAD_OUT_FRAMES};
     for (kmh, h) in [(1.0, 2.0), (3.0, 1.8), (5.0, 1.8), (7.0, 1.5)] {
-        let (_, m, r) = steady_walk(kmh, h, 8);
+        let (m, r) = steady(kmh, h, 8);
         let fps = m.fps();
         let lead = LEAD_IN_FRAMES as f64 / fps;
         assert!(m.events.iter().all(|e| e.time_s >= 0.0), "{kmh} km/h");
@@ -289,22 +277,17 @@ fn a_steady_walk_starts_and_ends_mid_motion() {
 /// also rose 3 mm after the lock.
 #[test]
 fn the_swing_heel_slows_and_descends_into_the_contact() {
-    use gaitfit::events::{EventKind, Side};
-    use gaitfit::generator::skeleton::{Joint, Landmark};
+    use gaitfit::events::EventKind;
+    use gaitfit::generator::skeleton::Joint;
     for (kmh, h) in [(1.5, 1.6), (3.0, 1.7), (5.0, 1.8), (7.0, 1.8), (7.0, 1.95)] {
-        let (_, m, _) = steady_walk(kmh, h, 8);
+        let (m, _) = steady(kmh, h, 8);
         let fps = m.fps();
         let mut swings = 0;
         for to in m.events.iter().filter(|e| e.kind == EventKind::ToeOff) {
-            let Some(hs) = m.events.iter().find(|e| {
-                e.kind == EventKind::HeelStrike && e.side == to.side && e.time_s > to.time_s
-            }) else {
+            let Some(hs) = common::next_event(&m, EventKind::HeelStrike, to.side, to.time_s) else {
                 continue;
             };
-            let (heel, knee) = match to.side {
-                Side::Left => (Landmark::LHeel, Joint::LKnee),
-                Side::Right => (Landmark::RHeel, Joint::RKnee),
-            };
+            let (heel, knee) = (leg(to.side).heel, Joint::leg(to.side)[1]);
             // Frames of the second half of the swing, up to the last one at or before contact.
             let mid = ((to.time_s + 0.5 * (hs.time_s - to.time_s)) * fps).ceil() as usize;
             let last = (hs.time_s * fps + 1e-9).floor() as usize;

@@ -6,9 +6,9 @@
 //!
 //! Independent of the generator's bookkeeping: heights are the drawn heel landmark's, and
 //! midstance is where the drawn hip joint passes over the drawn ankle.
-use gaitfit::events::{EventKind, Side};
-use gaitfit::generator::skeleton::Landmark;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
+mod common;
+
+use gaitfit::events::EventKind;
 
 /// For every steady stance (foot flat followed by heel off on the same side) of an 8-step
 /// steady walk at `kmh`, `h` m: the highest the stance heel gets from foot flat to the later of
@@ -17,28 +17,18 @@ use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 /// foot flat with the heel more than 1 mm up) as fractions of the gait cycle (heel strike to
 /// the same foot's next heel strike), over the stances with a next heel strike.
 fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
-    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-    let opts = WalkOptions {
-        height_m: h,
-        ..Default::default()
-    };
-    let (m, _) = generate_walk(&schedule, &opts).unwrap();
+    let (m, _) = common::steady(kmh, h, 8);
     let fps = m.fps();
     let frame = |t: f64| (t * fps).round() as usize;
     let (mut worst, mut lead, mut n) = (0.0f64, i64::MAX, 0);
     let mut rise = [f64::INFINITY, f64::NEG_INFINITY];
     for e in m.events.iter().filter(|e| e.kind == EventKind::FootFlat) {
-        let Some(off) = m
-            .events
-            .iter()
-            .find(|o| o.kind == EventKind::HeelOff && o.side == e.side && o.time_s > e.time_s)
-        else {
+        let Some(off) = common::next_event(&m, EventKind::HeelOff, e.side, e.time_s) else {
             continue;
         };
-        let (hip, ankle, heel) = match e.side {
-            Side::Left => (Landmark::LHip, Landmark::LAnkle, Landmark::LHeel),
-            Side::Right => (Landmark::RHip, Landmark::RAnkle, Landmark::RHeel),
-        };
+        let common::Leg {
+            hip, ankle, heel, ..
+        } = common::leg(e.side);
         let (ff, ho) = (frame(e.time_s), frame(off.time_s).min(m.len() - 1));
         // Midstance: the first frame with the hip joint ahead of the ankle.
         let Some(mid) = (ff..m.len()).find(|&i| m.landmark(i, hip).x >= m.landmark(i, ankle).x)

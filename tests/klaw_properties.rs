@@ -2,35 +2,19 @@
 //! frequency, phase end conditions, double support, stance-foot sliding and ground penetration.
 //!
 //! Range: 1–7 km/h and 1.5–2.0 m (the issue's), sampled by proptest plus the range's corners.
+mod common;
+
 use gaitfit::events::{EventKind, Side};
 use gaitfit::generator::checks::{double_support_timing, ground_penetration, stance_sliding};
 use gaitfit::generator::skeleton::Landmark;
 use gaitfit::generator::walking::high_level::phase_times;
 use gaitfit::generator::walking::swing::RECOVERY_MAX_RAD;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions, WalkParams};
 use proptest::prelude::*;
-
-fn walk(
-    kmh: f64,
-    h: f64,
-    steps: usize,
-) -> (
-    gaitfit::generator::motion::Motion,
-    gaitfit::generator::walking::WalkReport,
-    WalkOptions,
-) {
-    let opts = WalkOptions {
-        height_m: h,
-        ..Default::default()
-    };
-    let sched = [ScheduleEntry::at_speed(kmh / 3.6, steps)];
-    let (m, r) = generate_walk(&sched, &opts).unwrap();
-    (m, r, opts)
-}
 
 /// Checks every property of a walk at `kmh` and height `h`; returns the first violation.
 fn check(kmh: f64, h: f64) -> Result<(), String> {
-    let (m, r, opts) = walk(kmh, h, 6);
+    let opts = common::options(h, false, false);
+    let (m, r) = common::steady(kmh, h, 6);
     let ctx = format!("{kmh:.2} km/h, h = {h:.3} m");
     let l = &r.steps[0];
     let sl = l.step_length_m;
@@ -147,19 +131,7 @@ fn the_last_half_step_of_a_slow_stop_moves_the_swing_foot_continuously() {
     // 7 cm over 9 cm of travel, nearly along the circle the ankle can reach about the knee, so
     // the slaved knee angle slid the ankle 10 cm along the curve in 11 ms (heel 15 cm in one
     // frame, frame 462). The lift is now capped at a quarter of the travel.
-    let opts = WalkOptions {
-        height_m: 1.8,
-        stop: true,
-        ..Default::default()
-    };
-    let sched = [ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(1.0 / 3.6),
-            ..Default::default()
-        },
-        steps: 4,
-    }];
-    let (m, _) = generate_walk(&sched, &opts).unwrap();
+    let (m, _) = common::walk(&[(1.0, 4)], 1.8, false, true);
     let feet = [
         Landmark::LAnkle,
         Landmark::LHeel,
@@ -236,14 +208,7 @@ fn walks_with_a_stop_never_saturate_the_recovery() {
         for j in 0..=10 {
             let (kmh, h) = (1.0 + 0.5 * f64::from(i), 1.5 + 0.05 * f64::from(j));
             for rest in [true, false] {
-                let opts = WalkOptions {
-                    height_m: h,
-                    start_from_rest: rest,
-                    stop: true,
-                    ..Default::default()
-                };
-                let sched = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-                let (m, r) = generate_walk(&sched, &opts).unwrap();
+                let (m, r) = common::walk(&[(kmh, 8)], h, rest, true);
                 let ctx = format!("{kmh:.1} km/h, h = {h:.2} m, from standing {rest}");
                 for s in &r.steps {
                     if s.recovery_rad > most.0 {

@@ -6,19 +6,15 @@
 //!
 //! Independent of the dynamics' own bookkeeping: both are finite differences of the drawn
 //! landmarks (the pelvis as the mid-point of the hip joints, which cancels the pelvic list).
-use gaitfit::events::{EventKind, Side};
+mod common;
+
+use gaitfit::events::EventKind;
 use gaitfit::generator::skeleton::Landmark;
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 
 /// (most negative pelvis vertical velocity, fastest hip approach to the landing heel) over the
 /// contacts of a steady 8-step walk, m/s, and the number of contacts.
 fn approach(kmh: f64, h: f64) -> (f64, f64, usize) {
-    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-    let opts = WalkOptions {
-        height_m: h,
-        ..Default::default()
-    };
-    let (m, _) = generate_walk(&schedule, &opts).unwrap();
+    let (m, _) = common::steady(kmh, h, 8);
     let fps = m.fps();
     let (mut vy_min, mut close_max, mut n) = (f64::INFINITY, 0.0f64, 0);
     for e in m.events.iter().filter(|e| e.kind == EventKind::HeelStrike) {
@@ -30,10 +26,7 @@ fn approach(kmh: f64, h: f64) -> (f64, f64, usize) {
         let pelvis =
             |i: usize| 0.5 * (m.landmark(i, Landmark::LHip) + m.landmark(i, Landmark::RHip));
         let vy = (pelvis(f).y - pelvis(f - 1).y) * fps;
-        let (hip, heel) = match e.side {
-            Side::Left => (Landmark::LHip, Landmark::LHeel),
-            Side::Right => (Landmark::RHip, Landmark::RHeel),
-        };
+        let (hip, heel) = (common::leg(e.side).hip, common::leg(e.side).heel);
         // The landed heel (on the ground two frames after the contact).
         let ground = m.landmark(f + 2, heel);
         let d = |i: usize| (m.landmark(i, hip) - ground).length();
@@ -90,23 +83,17 @@ fn slow_walks_keep_the_quadratic_extension() {
 /// negative pelvis vertical velocity over the last frame before a contact (m/s), over a steady
 /// 8-step walk at `kmh`, 1.8 m.
 fn midstance_knee_and_descent(kmh: f64) -> (f64, f64) {
-    let schedule = [ScheduleEntry::at_speed(kmh / 3.6, 8)];
-    let (m, _) = generate_walk(&schedule, &WalkOptions::default()).unwrap();
+    let (m, _) = common::steady(kmh, 1.8, 8);
     let fps = m.fps();
     let frame = |t: f64| (t * fps).round() as usize;
     let mut straightest = f64::INFINITY;
     for e in m.events.iter().filter(|e| e.kind == EventKind::FootFlat) {
-        let Some(off) = m
-            .events
-            .iter()
-            .find(|o| o.kind == EventKind::MetaOff && o.side == e.side && o.time_s > e.time_s)
-        else {
+        let Some(off) = common::next_event(&m, EventKind::MetaOff, e.side, e.time_s) else {
             continue;
         };
-        let (hip, knee, ankle) = match e.side {
-            Side::Left => (Landmark::LHip, Landmark::LKnee, Landmark::LAnkle),
-            Side::Right => (Landmark::RHip, Landmark::RKnee, Landmark::RAnkle),
-        };
+        let common::Leg {
+            hip, knee, ankle, ..
+        } = common::leg(e.side);
         for i in frame(e.time_s) + 1..frame(off.time_s).min(m.len()) {
             let thigh = m.landmark(i, knee) - m.landmark(i, hip);
             let shank = m.landmark(i, ankle) - m.landmark(i, knee);

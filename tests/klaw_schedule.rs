@@ -4,19 +4,11 @@ use gaitfit::events::{EventKind, Side};
 use gaitfit::generator::checks::{ground_penetration, stance_sliding};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::Landmark;
-use gaitfit::generator::walking::{
-    generate_walk, read_schedule, ScheduleEntry, WalkOptions, WalkParams, WalkReport,
-};
+use gaitfit::generator::walking::{generate_walk, read_schedule, WalkOptions, WalkReport};
 
-fn kmh(v: f64, steps: usize) -> ScheduleEntry {
-    ScheduleEntry {
-        params: WalkParams {
-            speed_m_per_s: Some(v / 3.6),
-            ..Default::default()
-        },
-        steps,
-    }
-}
+mod common;
+
+use common::leg;
 
 /// Heel x of the landing foot just after each heel strike inside the motion, with its time.
 fn heel_strikes(m: &Motion) -> Vec<(f64, Side, f64)> {
@@ -25,13 +17,7 @@ fn heel_strikes(m: &Motion) -> Vec<(f64, Side, f64)> {
         .filter(|e| e.kind == EventKind::HeelStrike)
         .filter_map(|e| {
             let f = (e.time_s * m.fps()).ceil() as usize;
-            (f < m.len()).then(|| {
-                let lm = match e.side {
-                    Side::Left => Landmark::LHeel,
-                    Side::Right => Landmark::RHeel,
-                };
-                (e.time_s, e.side, m.landmark(f, lm).x)
-            })
+            (f < m.len()).then(|| (e.time_s, e.side, m.landmark(f, leg(e.side).heel).x))
         })
         .collect()
 }
@@ -78,7 +64,7 @@ fn each_step_meets_its_own_command(m: &Motion, r: &WalkReport) {
 fn figure_8_sequences_two_and_five_km_per_h() {
     // Fig. 8: one leg, 2 km/h for 4 cycles (8 steps) and 5 km/h for 3 cycles (6 steps), h = 1.8 m.
     for (v, cycles) in [(2.0, 4), (5.0, 3)] {
-        let (m, r) = generate_walk(&[kmh(v, 2 * cycles)], &WalkOptions::default()).unwrap();
+        let (m, r) = common::steady(v, 1.8, 2 * cycles);
         assert_eq!(r.steps.len(), 2 * cycles);
         each_step_meets_its_own_command(&m, &r);
         // One leg's cycles: its heel strikes are a stride (two step lengths) and a cycle time
@@ -109,12 +95,7 @@ fn figure_8_sequences_two_and_five_km_per_h() {
 fn accelerating_and_decelerating_from_standing_to_stop() {
     // From standing at 2 km/h, up to 5 km/h, down to 3 km/h, and stop: the steps change at
     // one-step granularity and each meets its own constraints.
-    let opts = WalkOptions {
-        start_from_rest: true,
-        stop: true,
-        ..Default::default()
-    };
-    let (m, r) = generate_walk(&[kmh(2.0, 3), kmh(5.0, 4), kmh(3.0, 3)], &opts).unwrap();
+    let (m, r) = common::walk(&[(2.0, 3), (5.0, 4), (3.0, 3)], 1.8, true, true);
     assert_eq!(r.steps.len(), 10);
     // The first step, from standing with the feet side by side, keeps its length (its swing
     // foot travels one step length, half a stride); the last is a half step (to standing).
@@ -199,11 +180,8 @@ fn the_stop_brings_the_trailing_foot_alongside_and_comes_to_rest() {
     // From steady walking: a last half step, then the trailing foot lands beside the stance foot
     // (stride width kept) and the body comes to rest, at 1, 3, 5 and 7 km/h.
     for v in [1.0, 3.0, 5.0, 7.0] {
-        let opts = WalkOptions {
-            stop: true,
-            ..Default::default()
-        };
-        let (m, r) = generate_walk(&[kmh(v, 4)], &opts).unwrap();
+        let opts = common::options(1.8, false, true);
+        let (m, r) = common::walk(&[(v, 4)], 1.8, false, true);
         each_step_meets_its_own_command(&m, &r);
         let n = m.len();
         let fps = m.fps();
@@ -334,33 +312,9 @@ fn the_cli_says_when_it_ramps_a_schedule() {
     assert!(!err.contains("max_speed_change_m_per_s"), "{err}");
 }
 
-/// The hip, knee, ankle and heel landmarks of one side's leg.
-fn leg(side: Side) -> (Landmark, Landmark, Landmark, Landmark) {
-    match side {
-        Side::Left => (
-            Landmark::LHip,
-            Landmark::LKnee,
-            Landmark::LAnkle,
-            Landmark::LHeel,
-        ),
-        Side::Right => (
-            Landmark::RHip,
-            Landmark::RKnee,
-            Landmark::RAnkle,
-            Landmark::RHeel,
-        ),
-    }
-}
-
 /// Walks of 6 steps from standing to a stop at `v` km/h and height `h`.
 fn from_standing(v: f64, h: f64) -> Motion {
-    let opts = WalkOptions {
-        height_m: h,
-        start_from_rest: true,
-        stop: true,
-        ..Default::default()
-    };
-    generate_walk(&[kmh(v, 6)], &opts).unwrap().0
+    common::from_standing(v, h, 6).0
 }
 
 /// From standing at 1, 2 and 3 km/h × 1.5/1.8/2.0 m, no foot point goes more than 1 mm into the
@@ -435,7 +389,7 @@ fn swing_peak_over_mean(m: &Motion) -> Vec<f64> {
 fn swing_ankle_peak_speed_from_standing() {
     // Steady 5 and 7 km/h: the target.
     for v in [5.0, 7.0] {
-        let (m, _) = generate_walk(&[kmh(v, 6)], &WalkOptions::default()).unwrap();
+        let (m, _) = common::steady(v, 1.8, 6);
         let r = swing_peak_over_mean(&m);
         println!("steady {v} km/h: {r:.2?}");
         assert!(r.len() >= 5, "{r:?}");
@@ -507,7 +461,8 @@ fn the_first_swing_from_standing_leaves_with_its_thigh_behind_its_landing_angle(
         let first = |kind: EventKind| m.events.iter().find(|e| e.kind == kind).unwrap();
         let (toe_off, hs) = (first(EventKind::ToeOff), first(EventKind::HeelStrike));
         assert_eq!(toe_off.side, hs.side);
-        let (hip, knee, ankle, heel) = leg(toe_off.side);
+        let l = leg(toe_off.side);
+        let (hip, knee, ankle, heel) = (l.hip, l.knee, l.ankle, l.heel);
         let thigh = |f: usize| {
             let (h, k) = (m.landmark(f, hip), m.landmark(f, knee));
             (h.x - k.x).atan2(h.y - k.y)
@@ -566,7 +521,8 @@ fn the_second_swing_from_standing_leaves_from_its_toes() {
             .nth(1)
             .unwrap();
         let f = (toe_off.time_s * m.fps()).floor() as usize;
-        let (hip, knee, ankle, heel) = leg(toe_off.side);
+        let l = leg(toe_off.side);
+        let (hip, knee, ankle, heel) = (l.hip, l.knee, l.ankle, l.heel);
         let p = |l: Landmark| m.landmark(f, l);
         let thigh = (p(hip) - p(knee)).normalize();
         let shank = (p(knee) - p(ankle)).normalize();
@@ -597,13 +553,7 @@ fn heels_are_on_the_floor_while_standing() {
     let mut failures = Vec::new();
     for v in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0] {
         for h in [1.5, 1.8, 2.0] {
-            let opts = WalkOptions {
-                height_m: h,
-                start_from_rest: true,
-                stop: true,
-                ..Default::default()
-            };
-            let (m, _) = generate_walk(&[kmh(v, 2)], &opts).unwrap();
+            let (m, _) = common::from_standing(v, h, 2);
             for (what, f) in [("first", 0), ("last", m.len() - 1)] {
                 for lm in [
                     Landmark::LHeel,
@@ -652,19 +602,11 @@ fn every_stance_has_its_events_in_order_and_its_foot_on_the_ground() {
     let mut stances = 0;
     for (sched, rest) in schedules {
         for h in [1.5, 1.8, 2.0] {
-            let opts = WalkOptions {
-                height_m: h,
-                start_from_rest: rest,
-                stop: rest,
-                ..Default::default()
-            };
-            let entries: Vec<ScheduleEntry> = sched.iter().map(|&(v, n)| kmh(v, n)).collect();
-            let (m, _) = generate_walk(&entries, &opts).unwrap();
+            let (m, _) = common::walk(sched, h, rest, rest);
             for side in [Side::Left, Side::Right] {
-                let (heel, ball, toe) = match side {
-                    Side::Left => (Landmark::LHeel, Landmark::LBall, Landmark::LToe),
-                    Side::Right => (Landmark::RHeel, Landmark::RBall, Landmark::RToe),
-                };
+                let common::Leg {
+                    heel, ball, toe, ..
+                } = leg(side);
                 let evs: Vec<_> = m.events.iter().filter(|e| e.side == side).collect();
                 for (i, hs) in evs.iter().enumerate() {
                     if hs.kind != HeelStrike {

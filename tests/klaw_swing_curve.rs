@@ -7,11 +7,12 @@
 //! The measure is `checks::continuity`'s own (each frame-to-frame step against the median of
 //! the 3 steps on either side, floors 1e-4 m and 1e-3 rad), restricted to the swing leg's ankle
 //! centre and knee rotation over swing1 (toe off to `swing1_end` = 50 % of the swing).
+mod common;
+
 use gaitfit::events::{EventKind, Side};
-use gaitfit::generator::checks::{rotation_angle, step_ratios, ContinuityOptions};
+use gaitfit::generator::checks::{step_ratios, ContinuityOptions};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::{Joint, Landmark};
-use gaitfit::generator::walking::{generate_walk, ScheduleEntry, WalkOptions};
 use proptest::prelude::*;
 
 /// The worst ratio of the swing leg's ankle and knee steps over every swing1 of `m`, with a
@@ -22,21 +23,13 @@ fn swing1_worst(m: &Motion) -> (f64, String) {
     let lms = m.all_landmarks();
     let mut worst = (0.0, String::from("no swing1"));
     for side in [Side::Left, Side::Right] {
-        let (ankle, knee) = match side {
-            Side::Left => (Landmark::LAnkle, Joint::LKnee),
-            Side::Right => (Landmark::RAnkle, Joint::RKnee),
-        };
+        let (ankle, knee) = (common::leg(side).ankle, Joint::leg(side)[1]);
         let ai = Landmark::ALL.iter().position(|&l| l == ankle).unwrap();
-        let ki = Joint::ALL.iter().position(|&j| j == knee).unwrap();
         let ankle_steps: Vec<f64> = lms
             .windows(2)
             .map(|p| (p[1][ai] - p[0][ai]).length())
             .collect();
-        let knee_steps: Vec<f64> = m
-            .poses()
-            .windows(2)
-            .map(|p| rotation_angle(p[0].rotations[ki], p[1].rotations[ki]))
-            .collect();
+        let knee_steps = common::joint_steps(m, knee);
         // `checks::continuity`'s own ratios (a step without neighbours counts as 0).
         let ratios = |steps: &[f64], floor| -> Vec<f64> {
             step_ratios(steps, o.window, floor)
@@ -71,18 +64,9 @@ fn swing1_worst(m: &Motion) -> (f64, String) {
     worst
 }
 
+/// The walk of `sched` ((km/h, steps) entries) at height `h`, from standing with a stop.
 fn walk(sched: &[(f64, usize)], h: f64) -> Motion {
-    let schedule: Vec<ScheduleEntry> = sched
-        .iter()
-        .map(|&(kmh, steps)| ScheduleEntry::at_speed(kmh / 3.6, steps))
-        .collect();
-    let opts = WalkOptions {
-        height_m: h,
-        start_from_rest: true,
-        stop: true,
-        ..Default::default()
-    };
-    generate_walk(&schedule, &opts).unwrap().0
+    common::walk(sched, h, true, true).0
 }
 
 /// The case that failed (`LIFT_OVER_TOE_OFF`'s paper value, the peak lifted from the toe-off
