@@ -281,13 +281,16 @@ impl Closing {
             })
             .unwrap_or(0);
         stance_leg.plan_heel_rocker(&hips[reach_from..], g.heel_rocker_min);
+        // The early ankle rate the last swing lands into is the rolling rocker's, from the reach
+        // on (see `contact_ankle_rate`).
+        let t_reach = hips[reach_from].0;
         let mut flat = false;
         for &(t, hip, dz) in &hips {
             let rho = if flat {
                 0.0
             } else {
                 let p = stance_leg.advance(t, hip, dz);
-                if t <= EARLY {
+                if (t_reach - 1e-9..=t_reach + EARLY).contains(&t) {
                     c.stance_theta5.push((t, p.theta5));
                 }
                 if stance_leg.period != FootPeriod::HeelRocker {
@@ -337,15 +340,24 @@ impl Closing {
         c
     }
 
-    /// The landing foot's mean ankle rate dθ5/dt over the first `window` s of its heel rocker
-    /// (at most `EARLY`, 0.05 s), rad/s: the last step's swing foot lands into it (see
+    /// The landing foot's mean ankle rate dθ5/dt over the first `window` s of its rolling heel
+    /// rocker (at most `EARLY`, 0.05 s), rad/s: the last step's swing foot lands into it (see
     /// [`super::swing::SwingFoot::theta5_rate_hs`]), as every step's lands into the next
     /// step's heel rocker.
+    ///
+    /// The window starts where the straight leg first reaches the pitched foot's ankle, not at
+    /// the contact: until then (up to a few ms; the 3-D leg may fall a millimetre short) the
+    /// foot holds its landing pitch while the shank turns over it, θ5 *rising*. Measured from
+    /// the contact, that hold cancelled the roll (4 km/h × 2.0 m: +0.47 rad/s over 10 ms, the
+    /// roll −1.32), so the swing ankle arrived at rest while the stance ankle then turned at
+    /// 1.2 rad/s — 0.012 rad in the first frame against a median of 0.0023 (continuity 5.23;
+    /// 5.34 on 1.5 → 4 km/h × 2.0 m; 3.23 and 3.61 now).
     pub fn contact_ankle_rate(&self, window: f64) -> f64 {
         let s = &self.stance_theta5;
+        let t0 = s.first().map_or(0.0, |x| x.0);
         let (Some(&a), Some(&b)) = (
             s.first(),
-            s.iter().take_while(|x| x.0 <= window + 1e-9).last(),
+            s.iter().take_while(|x| x.0 <= t0 + window + 1e-9).last(),
         ) else {
             return 0.0;
         };
