@@ -41,6 +41,8 @@ pub const KNEE_SOFT: f64 = 0.0015;
 /// the rule's knee from above as a critically damped second-order system with this time
 /// constant: never less flexed than the rule (a more flexed knee only asks the foot to roll
 /// a little earlier, so the ankle stays in reach), C¹ through its peak and its return to rest.
+/// The walk's rocker landings now ease from their own knee and rate instead
+/// ([`KNEE_ROCKER_EASE`]); this ease is what [`VirtualLeg::knee_ease`] does without that state.
 pub const KNEE_EASE: f64 = 0.015;
 
 /// Time constant of the knee's ease from a straight-leg landing, s: where no heel rocker could be
@@ -53,9 +55,34 @@ pub const KNEE_EASE: f64 = 0.015;
 /// straighter knee only lets the foot roll a little later; it is always in reach).
 pub const KNEE_LAND_EASE: f64 = 0.03;
 
-/// The knee is eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
+/// Time constant of the knee's ease after a planned heel rocker's landing that narrowed the
+/// knee's soft margin ([`VirtualLeg::knee_soft`] below [`KNEE_SOFT`]: slow walks), s. The ease
+/// starts from the rocker's knee *and its rate* at foot flat ([`HeelRocker::knee_end`]) and
+/// follows the flat and heel-off rules' knee from either side, as a critically damped
+/// second-order system (a straighter knee only keeps the foot flat a little longer).
+///
+/// Why: such a rocker lands where the flat foot's knee is still straightening fast (it is
+/// met with that rate), 2.9–3.4 rad/s at 1 km/h × 1.7 m, 0.4 mm short of the straight leg;
+/// the rule's soft blend is 2σ = 0.4 mm wide there, so its knee stops within one 10 ms frame,
+/// and the former ease (from the rule's knee at rest, [`KNEE_EASE`], only from the more flexed
+/// side) threw the landing's rate away: the foot had to roll at once (foot flat and heel off
+/// 2 ms apart) and the heel left the floor at 0.7 mm/frame from rest (continuity 6.3–6.9 at
+/// 1 km/h × 1.7 m; switching the ease off moved the jump to the knee, 6.1–6.7). Carrying the
+/// rate on, the knee decelerates over ≈ 4 frames, straightening to near straight (the
+/// least flexion the soft rule allows is not a floor for it) and settling back on the rule's
+/// knee, and the heel starts from rest. Measured (1 km/h × 1.7 m from standing with a stop,
+/// `1x8` / `5x4,1x6` / `6x4,1x6`, 6.73/6.86/6.30 before): 15 ms 4.85/4.88/4.76, 30 ms
+/// 3.83/3.72/4.08 but 1 km/h × 1.8 m 3.27 → 4.18, 50 ms 3.83/3.52/4.08 and 1.8 m unchanged.
+/// Easing every rocker's knee this way (not only narrowed ones) spoiled faster walks (7 km/h ×
+/// 1.5 m 5.29 → 18.1, 4 km/h × 1.5 m 3.75 → 5.22); easing only the landings below
+/// [`KNEE_EASE_SOFT`] left 1 km/h × 1.6 m's knee stopping dead at heel off (6.81; its landing
+/// narrows the margin to ≈ 0.6 mm).
+pub const KNEE_ROCKER_EASE: f64 = 0.05;
+
+/// The knee was eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
 /// margin ([`VirtualLeg::knee_soft`]) below this, m: a landing within 0.33 mm of the straight
-/// leg. Measured (8 steps): 1 km/h lands at 0.04–0.30 mm, 2 km/h at 0.41–0.67 mm after its
+/// leg (every narrowed landing is now eased, [`KNEE_ROCKER_EASE`]; the landing choice of
+/// [`VirtualLeg::plan_heel_rocker`] still tells nearly straight landings apart by this). Measured (8 steps): 1 km/h lands at 0.04–0.30 mm, 2 km/h at 0.41–0.67 mm after its
 /// first step, 3 km/h and faster at the full [`KNEE_SOFT`]. Easing every leg made the heel
 /// start rising from rest at speed at 3 km/h (ratios 3.8 → 7.1–8.6) and 2 km/h × 2.0 m's
 /// elbows worse (6.0 → 7.3); above this threshold their rules' knees are smooth already.
@@ -187,12 +214,16 @@ pub struct VirtualLeg {
     pub slow_knee_start: bool,
     /// State of the knee's eased straightening (see [`KNEE_EASE`]): time, knee flexion and its
     /// rate at the last flat / heel-off sample, and the rule's knee then. `None` before the
-    /// foot is flat.
+    /// foot is flat (set at foot flat by a landing, see [`KNEE_LAND_EASE`] and
+    /// [`KNEE_ROCKER_EASE`]).
     pub knee_ease: Option<[f64; 4]>,
     /// Whether the straight leg landed the foot (no planned heel rocker): the knee then eases
     /// from straight toward the flat and heel-off rules' knee from either side (see
     /// [`KNEE_LAND_EASE`]), not only from the more flexed side.
     pub ease_from_landing: bool,
+    /// Whether the knee ease after a planned heel rocker's landing started from the rocker's
+    /// knee and rate (see [`KNEE_EASE`]): it then eases toward the rule's knee from either side.
+    pub ease_from_rocker: bool,
     /// Longest hip–ankle span the flat and heel-off rules draw, m: `l3 + l4` (the paper's
     /// straight knee), shorter where the stance leg locked short of `l1` at speed
     /// (`StanceSpec::drawn_span`): the knee then keeps that flexion through midstance and heel
@@ -214,6 +245,9 @@ pub struct HeelRocker {
     pub end: f64,
     /// `(t, ρ)` samples up to `end`.
     pub table: Vec<(f64, f64)>,
+    /// The knee flexion at `end` (the flat foot's), rad, and its rate there, rad/s: the knee
+    /// ease after foot flat starts from them (see [`KNEE_EASE`]).
+    pub knee_end: [f64; 2],
 }
 
 impl HeelRocker {
@@ -498,6 +532,7 @@ impl VirtualLeg {
             slow_knee_start: true,
             knee_ease: None,
             ease_from_landing: false,
+            ease_from_rocker: false,
             span_max: body.l3 + body.l4,
             rocker_gap: None,
         }
@@ -763,7 +798,16 @@ impl VirtualLeg {
             if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
                 best_fast = f >= 2.0;
                 best_dips = knee_dips(k_end, big_t, r0, k_rate);
-                best = Some((cost, HeelRocker { end, table }, landing, soft));
+                best = Some((
+                    cost,
+                    HeelRocker {
+                        end,
+                        table,
+                        knee_end: [k_end, k_rate],
+                    },
+                    landing,
+                    soft,
+                ));
             }
             left = left.min(scan + 1) - 1;
         }
@@ -778,7 +822,9 @@ impl VirtualLeg {
     /// The leg length of the knee eased toward the rule's (`d_rule`) at time `t`, never longer
     /// than it (see [`KNEE_EASE`]): the exact critically damped step from the last sample's
     /// knee and rate toward the rule's knee; where the rule's knee is the more flexed, the knee
-    /// takes it and its rate.
+    /// takes it and its rate. After a straight-leg landing ([`KNEE_LAND_EASE`]) or a narrowed
+    /// rocker landing ([`KNEE_ROCKER_EASE`]) the knee eases from either side, longer or
+    /// shorter than the rule.
     fn eased_span(&mut self, t: f64, d_rule: f64) -> f64 {
         let (l3, l4) = (self.l3, self.l4);
         let k_rule = knee_for(l3, l4, d_rule);
@@ -787,6 +833,8 @@ impl VirtualLeg {
                 let h = t - t0;
                 let w = if self.ease_from_landing {
                     1.0 / KNEE_LAND_EASE
+                } else if self.ease_from_rocker {
+                    1.0 / KNEE_ROCKER_EASE
                 } else {
                     1.0 / KNEE_EASE
                 };
@@ -795,18 +843,21 @@ impl VirtualLeg {
                 let decay = (-w * h).exp();
                 let k1 = k_rule + (e + c * h) * decay;
                 let kd1 = (kd0 - w * c * h) * decay;
-                if k1 <= k_rule && !self.ease_from_landing {
+                // A knee eased from a straightening landing never passes straight: it stops
+                // there (not reached in the measured walks, whose rule's knee re-targets it).
+                let (k1, kd1) = if k1 < 0.0 { (0.0, 0.0) } else { (k1, kd1) };
+                if k1 <= k_rule && !self.ease_from_landing && !self.ease_from_rocker {
                     (k_rule, (k_rule - kr0) / h)
                 } else {
                     (k1, kd1)
                 }
             }
-            Some([_, k0, kd0, _]) if self.ease_from_landing => (k0, kd0),
+            Some([_, k0, kd0, _]) if self.ease_from_landing || self.ease_from_rocker => (k0, kd0),
             Some([_, k0, kd0, _]) => (k0.max(k_rule), kd0),
             None => (k_rule, 0.0),
         };
         self.knee_ease = Some([t, k, kd, k_rule]);
-        if self.ease_from_landing {
+        if self.ease_from_landing || self.ease_from_rocker {
             span_for(l3, l4, k)
         } else if k > k_rule {
             span_for(l3, l4, k).min(d_rule)
@@ -822,7 +873,11 @@ impl VirtualLeg {
         // How far `leg`'s ankle at roll `r` is beyond the straight leg's reach, m.
         let reach = |leg: &VirtualLeg, r: f64| leg.span_at(hip, dz, r) - l1;
         if self.period == FootPeriod::HeelRocker {
-            if let Some((end, rho)) = self.rocker.as_ref().map(|r| (r.end, r.rho_at(t))) {
+            if let Some((end, rho, [k_end, k_rate])) = self
+                .rocker
+                .as_ref()
+                .map(|r| (r.end, r.rho_at(t), r.knee_end))
+            {
                 if t < end {
                     self.rho = rho.max(self.rho);
                     return self.pose_at(hip, dz, self.rho);
@@ -830,6 +885,12 @@ impl VirtualLeg {
                 self.period = FootPeriod::Flat;
                 self.rho = 0.0;
                 self.transitions[0] = Some(end);
+                // A landing that narrowed the knee's soft margin (slow walks): the knee eases
+                // on from the rocker's knee and rate (see `KNEE_ROCKER_EASE`).
+                if self.knee_soft < KNEE_SOFT {
+                    self.knee_ease = Some([end, k_end, k_rate, k_end]);
+                    self.ease_from_rocker = true;
+                }
             }
         }
         if self.period == FootPeriod::HeelRocker {
@@ -890,8 +951,12 @@ impl VirtualLeg {
             } else {
                 d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
             };
-            // Only where the planned rocker landed nearly straight (see `KNEE_EASE_SOFT`).
-            let d_t = if self.knee_soft < KNEE_EASE_SOFT || self.ease_from_landing {
+            // Only where a landing narrowed the knee's soft margin (see `KNEE_EASE_SOFT`,
+            // `KNEE_ROCKER_EASE`) or the straight leg landed the foot (`KNEE_LAND_EASE`).
+            let d_t = if self.knee_soft < KNEE_EASE_SOFT
+                || self.ease_from_landing
+                || self.ease_from_rocker
+            {
                 self.eased_span(t, d_t)
             } else {
                 d_t
