@@ -453,8 +453,8 @@ fn a_straight_leg_landing_eases_the_knee() {
 /// × 1.7 m: 6.73 at frame 618, `5x4,1x6` 6.86 at 735, `6x4,1x6` 6.30 at 706, all r_heel), or,
 /// where the landing narrowed the knee's soft margin less, the knee stopped dead at heel off
 /// (1 km/h × 1.6 m: 6.81 at frame 600, r_knee). The ease now carries the rocker's knee rate on
-/// (`virtual_leg::KNEE_ROCKER_EASE`): measured 3.67 (frame 860, r_knee), 3.52 (845, l_ankle),
-/// 4.08 (816, l_ankle) and 3.32 (715, l_ankle): k = 5 met.
+/// (`virtual_leg::KNEE_ROCKER_EASE`): measured 3.67 (frame 860, r_knee), 3.45 (217, l_ankle),
+/// 3.56 (198, l_knee) and 3.32 (715, l_ankle): k = 5 met.
 #[test]
 fn a_slow_walk_lands_flat_without_a_heel_pop() {
     let mut failures = Vec::new();
