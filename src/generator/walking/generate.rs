@@ -13,7 +13,7 @@ use super::foot::{smoothstep, FootShape};
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::stop::{Closing, StopStart};
-use super::swing::{SwingCarry, SwingRun, SwingSpec, SwingStart, RECOVERY_MAX_RAD};
+use super::swing::{SwingCarry, SwingRun, SwingSpec, SwingStart};
 use super::virtual_leg::{
     smooth_roll, FootPeriod, LegPose, VirtualLeg, KNEE_SOFT, TOE_OFF_KNEE_RATE,
 };
@@ -102,6 +102,15 @@ pub struct StepReport {
     pub min_clearance_m: f64,
     /// When the stance leg was locked / passed the vertical, s from the step's start.
     pub lock_s: Option<f64>,
+    /// End of the swing's swing1 (the knee slaved to the ankle curve), as a fraction of the
+    /// swing: the paper's t1, `WalkAttributes::swing1_end`, except for the first swing from
+    /// standing (`first_swing_shape`, private: a continuous function of the walk's speed over
+    /// body height) and the stop's last swing.
+    pub swing1_end: f64,
+    /// The swing1 ankle curve's lift (`SwingSpec::ankle_lift`), m: the paper's
+    /// `WalkAttributes::ankle_lift_m`, except for the first swing from standing
+    /// (`first_swing_shape`) and the stop's last swing.
+    pub ankle_lift_m: f64,
 }
 
 /// The report of a generated walk.
@@ -894,56 +903,28 @@ pub fn generate_steps(
                 theta5_max: a.ankle_swing_dorsiflexion_max_deg.to_radians(),
                 max_step: a.max_step_s,
                 // Every swing, the first from standing too since klawstart2 (see
-                // `first_swing_choices`; it keeps the paper's toe off, `FIRST_PAPER_SWINGS`).
+                // `first_swing_shape`; it keeps the paper's toe off, `FIRST_PAPER_SWINGS`).
                 knee_brake: true,
                 theta3_rate_hs,
             }
         };
-        let choices = if first_swing {
-            first_swing_choices(a.swing1_end, a.ankle_lift_m)
+        let (swing1_end, ankle_lift) = if first_swing {
+            first_swing_shape(l.speed_m_per_s, opt.height_m, a.swing1_end, a.ankle_lift_m)
         } else if to_rest {
-            vec![(
+            (
                 (a.swing1_end + STOP_SWING1_DELAY).min(0.5 * (a.swing1_end + a.swing2_end)),
                 STOP_LIFT * a.ankle_lift_m,
-            )]
+            )
         } else {
-            vec![(a.swing1_end, a.ankle_lift_m)]
+            (a.swing1_end, a.ankle_lift_m)
         };
         // The swing2 recovery's actuator is carried over from the same leg's last swing: fast
         // walks alternate between legs (period-two pattern of the recovery).
         swing_guess[4] = recovery_by_leg[idx(swing_side)];
-        let mut chosen: Option<(f64, SwingSpec, SwingRun)> = None;
-        let mut failure = None;
-        for (swing1_end, lift) in choices {
-            let spec = swing_spec(swing1_end, lift);
-            match spec.solve_with(&swing_start, swing_guess, &swing_carry, l.speed_m_per_s) {
-                Ok(run) => {
-                    // Only the first swing from standing has two choices: the first whose
-                    // ankle speed is bell-shaped, else the smoother.
-                    let score = if run.recovery >= RECOVERY_MAX_RAD - 1e-9 {
-                        f64::INFINITY
-                    } else {
-                        ankle_peak_over_mean(&spec, &run)
-                    };
-                    if chosen.as_ref().is_none_or(|c| score < c.0) {
-                        chosen = Some((score, spec, run));
-                    }
-                    if score <= FIRST_SWING_PEAK_OVER_MEAN {
-                        break;
-                    }
-                }
-                Err(e) => failure = Some(e),
-            }
-        }
-        let (_, sspec, sw) = match chosen {
-            Some(c) => c,
-            None => {
-                return Err(num_err(
-                    stage("swing shooting"),
-                    failure.unwrap_or_else(|| "no swing to solve".into()),
-                ))
-            }
-        };
+        let sspec = swing_spec(swing1_end, ankle_lift);
+        let sw = sspec
+            .solve_with(&swing_start, swing_guess, &swing_carry, l.speed_m_per_s)
+            .map_err(|e| num_err(stage("swing shooting"), e))?;
         let swing_times = sspec.times;
         swing_guess = sw.params;
         if first_swing {
@@ -1007,6 +988,8 @@ pub fn generate_steps(
                 recovery_rad: sw.recovery,
                 min_clearance_m: sw.min_clearance,
                 lock_s: st_run.lock_time,
+                swing1_end,
+                ankle_lift_m: ankle_lift,
             });
         }
         // The pre-roll step too: the lead-in draws its last frames, and its stance leg is the
@@ -1808,7 +1791,7 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
 /// `TOE_OFF_KNEE_RATE`): the first only, whose trailing leg stood under the hip with its knee
 /// bounded by [`FIRST_TOE_OFF_THIGH`]. Until klawstart2 they also kept the paper's unbraked swing
 /// (`SwingSpec::knee_brake`); the first swing is now braked with its swing1 chosen by
-/// `first_swing_choices` (the measurements below are of that earlier state).
+/// `first_swing_shape` (the measurements below are of that earlier state).
 ///
 /// Measured (`kstart`: 6 steps from standing + stop, 1.5/1.8/2.0 m): 3 (the earlier hand-off)
 /// → 1 takes the second swing's ankle peak/mean speed at 1/2/3/5/7 km/h from 2.96/2.70/2.87,
@@ -1841,79 +1824,82 @@ pub fn sagittal_angles(hip: [f64; 2], ankle: [f64; 2], l3: f64, l4: f64) -> [f64
 /// only 3.5 mm), at 83 % 0.74.
 const FIRST_PAPER_SWINGS: usize = 1;
 
-/// Largest peak/mean speed of the swing model's ankle (`ankle_peak_over_mean`) for which the
-/// first swing from standing keeps the paper's end of swing1 (see `first_swing_choices`): a
-/// person's first swing (gait initiation) has a bell-shaped ankle speed, peak/mean ≈ 1.6–2.2
-/// (minimum jerk 1.875); issue 6's target for every drawn swing ankle is 2.5. The drawn ankle
-/// (3-D, per frame) measured up to 0.05 above the sagittal model's (3 km/h × 1.8/2.0 m from
-/// standing: 2.31/2.42 → 2.36/2.47), hence 0.1 below the target.
-pub const FIRST_SWING_PEAK_OVER_MEAN: f64 = 2.4;
+/// The first swing from standing's two shapes (see [`first_swing_shape`]), each at its end of
+/// the walk's speed over body height `u` (1/s):
+/// - slow (`u` up to [`FIRST_SWING_FAST`]`[0]`): an early end of swing1 with the paper's lift,
+///   swing1 lifting the foot and the braked swing2 carrying it over most of the swing. Its
+///   swing1 ends at [`FIRST_SWING1_ENDS`]`[0]` (25 % of the swing) up to
+///   `FIRST_SWING_SLOW[0]` and at `FIRST_SWING1_ENDS[1]` (30 %) from `FIRST_SWING_SLOW[1]`,
+///   blended in between;
+/// - fast (`u` from `FIRST_SWING_FAST[1]`): the paper's end of swing1 with no lift.
+///
+/// `FIRST_SWING_SLOW`, 1/s: where the early end goes from 25 % to 30 % of the swing. 30 % is
+/// not bell-shaped at the slowest walks (drawn ankle peak/mean 2.5–2.55 at 1 km/h × 1.8 m,
+/// against 2.31–2.35 with 25 %), and 25 % lifted the toe off too fast at 2–3 km/h (continuity
+/// 7.8 at 2 km/h × 1.5 m and 6.7 at 3 km/h × 1.8 m, against 2.9 and 3.2 with 30 %). The old
+/// selection by the model's peak/mean switched between them at 1.2–1.5 km/h, `u` = 0.21–0.22
+/// at 1.5/1.8/2.0 m.
+const FIRST_SWING_SLOW: [f64; 2] = [0.15, 0.22];
 
-/// The ends of swing1 (fractions of the swing) of the first swing from standing's early choices,
-/// tried in this order (see `first_swing_choices`).
+/// Where the first swing from standing goes from its slow shape to its fast one (see
+/// [`FIRST_SWING_SLOW`]), in walking speed over body height, 1/s: 0.46–0.62 is 2.5–3.3 km/h
+/// at 1.5 m, 3.0–4.0 km/h at 1.8 m, 3.3–4.5 km/h at 2.0 m. The old selection (the first of the
+/// two whose model ankle peak/mean was at most 2.4) switched at `u` = 0.53–0.54 at all three
+/// heights (2.9/3.4/3.9 km/h), which is why `u` and not the Froude number (0.044/0.050/0.060
+/// there) parameterizes the blend. Measured (`kfs`, 2 steps from standing + stop, 1.0–7.0 km/h
+/// every 0.1, drawn ankle): 0.46–0.62 kept the first swing's peak/mean ≤ 2.42 everywhere and
+/// halved the largest jump of its peak speed between neighbouring speeds at 1.8 m; a blend that
+/// drops the lift before the swing1 end rises (over 0.42–0.6) saturated the stubbing recovery
+/// at 2.8–3.5 km/h (peak/mean 3.3–3.7), and one that keeps the lift while the swing1 end rises
+/// threw the slaved ankle across its curve near t1 (peak/mean to 4.4).
+const FIRST_SWING_FAST: [f64; 2] = [0.46, 0.62];
+
+/// The early ends of swing1 (fractions of the swing) of the first swing from standing's slow
+/// shape: 25 % at the slowest walks, 30 % from `FIRST_SWING_SLOW[1]` (see [`FIRST_SWING_SLOW`]).
 ///
 /// Measured (`kstart`, 6 steps from standing + stop, braked first swing with the paper's lift,
 /// 1.5/1.8/2.0 m, on 4b3f141): 0.25 / 0.3 left its ankle's peak/mean speed at 1 km/h
 /// 2.30–2.43 / 2.50–2.64 and at 2 km/h 2.00–2.09 / 2.22–2.32, but 0.25 put the toe off at 2 km/h
 /// × 1.5 m and 3 km/h × 1.8 m at 7.8 and 6.7 (the toe leaving the floor, against 2.9 and 3.2
-/// with 0.3): so 0.25 is tried only where 0.3 is not bell-shaped (1 km/h, where it leaves the
-/// start region as it was). Before 4b3f141 (swing2's hip lead): 0.3 / 0.35 / 0.4 / 0.45 / 0.5
+/// with 0.3). Before 4b3f141 (swing2's hip lead): 0.3 / 0.35 / 0.4 / 0.45 / 0.5
 /// left 1 km/h at 2.3–2.4 / 2.5–2.7 / 2.9–3.0 / 3.2–3.4 / 3.7–3.9 and 2 km/h at 2.1–2.2 /
 /// 2.3–2.4 / 2.6–2.7 / 2.9–3.0 / 3.4–3.5.
-const FIRST_SWING1_ENDS: [f64; 2] = [0.3, 0.25];
+const FIRST_SWING1_ENDS: [f64; 2] = [0.25, 0.3];
 
-/// The swings tried for the first swing from standing, in order, `(swing1 end, ankle lift)`:
-/// the first whose ankle's peak/mean speed (`ankle_peak_over_mean`) is at most
-/// [`FIRST_SWING_PEAK_OVER_MEAN`] without running out of the stubbing recovery is kept, else the
-/// lowest. All are braked (`SwingSpec::knee_brake`).
+/// The first swing from standing's `(swing1 end, ankle lift)`: a continuous (C¹, smoothstep)
+/// function of the walk's speed over body height `u = speed / height`, from the slow shape
+/// (an early swing1 end, [`FIRST_SWING1_ENDS`], with the paper's `ankle_lift`) to the fast one
+/// (the paper's `swing1_end`, no lift) over [`FIRST_SWING_FAST`]. It is braked
+/// (`SwingSpec::knee_brake`) like every swing.
 ///
-/// Why: the first swing's ankle travels one step length from beside the stance foot while the
-/// hip starts from rest, so at the paper's end of swing1 (thigh at its heel-strike angle, ≈ 20 %
-/// of the step on) the knee is barely ahead of the toe-off ankle and the travel there is
-/// `MIN_TRAVEL`-bound (`SwingSpec::curve`). With the paper's lift that curve passes inside the
-/// circle the ankle can reach about the knee at t1 (by 5–16 mm at 1–3 km/h): the slaved ankle
-/// stays on the curve's near branch, rises in place (3 cm forward of 14 at 2 km/h × 1.8 m),
-/// and swing2 carried the rest (peak/mean 3.0–3.9 at 1–3 km/h, the knee locking at 7.7 rad/s
-/// unbraked); at 4–5 km/h the curve is barely reachable and the slaved ankle raced along it
-/// near t1 (4.4 m/s at 5 km/h × 1.5 m, peak/mean 2.4–5.9). Two ways out, each good where the
-/// other is not:
-/// - the paper's swing1 end with no lift (`(swing1_end, 0)`): the curve ends on the ankle's
-///   branch and swing1 carries its 30 %; at 1–2 km/h that end is too low (the toe needs the
-///   whole stubbing recovery at 2 km/h, peak/mean 3.3–4.2);
-/// - an early swing1 end with the paper's lift (`FIRST_SWING1_ENDS`): swing1 lifts the foot and
-///   the braked swing2 carries it over more than half the swing with a bell-shaped speed; at
-///   4–5 km/h the thigh's fast swing to its heel-strike angle drags the slaved ankle across the
-///   curve's branches (peak/mean 4–38).
+/// Why two shapes: the first swing's ankle travels one step length from beside the stance
+/// foot while the hip starts from rest, so at the paper's end of swing1 (thigh at its
+/// heel-strike angle, ≈ 20 % of the step on) the knee is barely ahead of the toe-off ankle and
+/// the travel there is `MIN_TRAVEL`-bound (`SwingSpec::curve`). With the paper's lift that
+/// curve passes inside the circle the ankle can reach about the knee at t1 (by 5–16 mm at
+/// 1–3 km/h): the slaved ankle stays on the curve's near branch, rises in place (3 cm forward
+/// of 14 at 2 km/h × 1.8 m), and swing2 carried the rest (peak/mean 3.0–3.9 at 1–3 km/h, the
+/// knee locking at 7.7 rad/s unbraked); at 4–5 km/h the curve is barely reachable and the
+/// slaved ankle raced along it near t1 (4.4 m/s at 5 km/h × 1.5 m, peak/mean 2.4–5.9). The
+/// paper's swing1 end with no lift ends the curve on the ankle's branch, but at 1–3 km/h it is
+/// too low (the toe needs the whole stubbing recovery, peak/mean 3.3–4.2); the early end with
+/// the lift lifts the foot in swing1, but at 4–5 km/h the thigh's fast swing to its
+/// heel-strike angle drags the slaved ankle across the curve's branches (peak/mean 4–38).
 ///
-/// Measured choices; the selection itself is by the simulated ankle, not by speed.
-fn first_swing_choices(swing1_end: f64, ankle_lift: f64) -> Vec<(f64, f64)> {
-    std::iter::once((swing1_end, 0.0))
-        .chain(FIRST_SWING1_ENDS.iter().map(|&e| (e, ankle_lift)))
-        .collect()
-}
-
-/// The swing model's ankle: its largest speed over the swing (sampled every 1/200 of it) over
-/// its mean speed from toe off to heel strike (straight-line distance over time). A person's
-/// swing ankle has a bell-shaped speed, peak/mean ≈ 1.4–2.2 (minimum jerk: 1.875).
-fn ankle_peak_over_mean(spec: &SwingSpec, run: &SwingRun) -> f64 {
-    let [t0, .., t3] = spec.times;
-    let ankle = |t: f64| spec.joints(t, &run.track.at(t).0).1;
-    let n = 200;
-    let dt = (t3 - t0) / n as f64;
-    let mut prev = ankle(t0);
-    let mut peak = 0.0f64;
-    for i in 1..=n {
-        let a = ankle(t0 + dt * i as f64);
-        peak = peak.max((a[0] - prev[0]).hypot(a[1] - prev[1]) / dt);
-        prev = a;
-    }
-    let (a, b) = (ankle(t0), ankle(t3));
-    let mean = (b[0] - a[0]).hypot(b[1] - a[1]) / (t3 - t0);
-    if mean > 0.0 {
-        peak / mean
-    } else {
-        f64::INFINITY
-    }
+/// Until klawtidy (session 9) the first of the three shapes (paper's, 30 %, 25 %) whose model
+/// ankle peak/mean was at most 2.4 was kept: the swing1 end jumped 0.5 → 0.3 and the first
+/// swing's drawn ankle peak speed by 0.39/0.53/0.90 m/s between neighbouring speeds 0.1 km/h
+/// apart (1.5/1.8/2.0 m), at 2.9/3.4/3.9 km/h; and it took up to three swing solves.
+fn first_swing_shape(speed: f64, height: f64, swing1_end: f64, ankle_lift: f64) -> (f64, f64) {
+    let u = speed / height;
+    let blend = |[a, b]: [f64; 2]| smoothstep((u - a) / (b - a));
+    let [slowest, slow] = FIRST_SWING1_ENDS;
+    let early = slowest + (slow - slowest) * blend(FIRST_SWING_SLOW);
+    let fast = blend(FIRST_SWING_FAST);
+    (
+        early + (swing1_end - early) * fast,
+        ankle_lift * (1.0 - fast),
+    )
 }
 
 /// The swing thigh's rate θ̇3 at heel strike for which the collision

@@ -70,7 +70,7 @@ pub struct SwingSpec<'a> {
     ///
     /// `generate` brakes every swing; the first from standing since klawstart2 (with its
     /// swing1 end and ankle lift chosen for a hip starting from rest, see `generate`'s
-    /// `first_swing_choices`).
+    /// `first_swing_shape`).
     pub knee_brake: bool,
     /// Thigh rate θ̇3 at heel strike, rad/s, which swing3 meets (with a second torque, a ramp
     /// `D·(t − t2)/(t_swing − t2)`) when `knee_brake` is set: `generate` passes the rate for
@@ -243,7 +243,7 @@ impl SwingFoot {
     /// least [`CLEARANCE_RAMP_MIN`] of the swing.
     ///
     /// Why the floor: the first swing from standing may end swing1 at 25–30 % of the swing
-    /// (`generate`'s `first_swing_choices`), and 30 % of that lifted the toe to its clearance in
+    /// (`generate`'s `first_swing_shape`), and 30 % of that lifted the toe to its clearance in
     /// 4 frames, then held it (2.5 km/h × 1.55 m from standing: 6.24 at the toe, 2 km/h × 1.8 m
     /// 3.74). Every swing whose swing1 ends at half the swing or later (the paper's default, the
     /// stop's) keeps its ramp.
