@@ -9,6 +9,22 @@
 //! stance is completed kinematically, §3), as in a compass gait. The telescopic leg absorbs the
 //! hip's velocity along the new leg, so nothing of the upper body's motion is lost — the loss is
 //! the swing leg's momentum along the new leg, taken by the ground.
+//!
+//! **The hip's approach to the landing foot (issue 6).** With the swing thigh landing at the
+//! collision-neutral rate (`generate`'s `neutral_landing_rate`) the hip's velocity, and `θ̇2`,
+//! are continuous across the impact. So the new leg's initial `ẇ⁺` (the hip closing on the new
+//! ankle) is the old stance's hip velocity along the new leg. For a symmetric landing
+//! (`θ1 = ±a`) it is `ẇ⁺ = ẇ cos 2a − w θ̇1 sin 2a` (tested below). The collision carries the
+//! approach; it does not create it. Measured at 7 km/h × 1.5 m (Froude `v²/(g·l1)` 0.53, at the
+//! human walk–run transition; `2a` = 67°): `ẇ` 1.34 m/s, `w θ̇1` 2.50 m/s, so `ẇ⁺` = −1.77 m/s.
+//! The drawn hip closes on the heel at 13 mm/frame in the first frame after contact, against
+//! 2 mm/frame in the frame before. A rate that started near zero would need `ẇ ≈ 5.9` m/s or
+//! `θ̇1 ≈ 0.75` rad/s at heel strike, neither of which a walk meeting eq. 3 has. The other way to
+//! get it is an impulse along the new leg (a rigid or partly plastic landing), which kinks the
+//! hip's path. Measured, keeping 80 % of `ẇ⁺`: the hip's vertical velocity jumps from −0.26 to
+//! +0.08 m/s at the impact (0.44 m/s between two drawn frames). The 1 km/h walks and the
+//! 2 → 5 → 3 km/h × 2.0 m schedule then fail (continuity 9.6–11.3), so the telescopic collision
+//! is kept.
 use super::body::Body;
 use super::dynamics::{solve3, StanceModel};
 use super::stance::StanceStart;
@@ -112,6 +128,61 @@ mod tests {
             (vh2[0] - vh[0]).abs() < 0.15 * vh[0].abs(),
             "{vh:?} → {vh2:?}"
         );
+    }
+
+    #[test]
+    fn the_approach_along_the_new_leg_is_the_old_stances_hip_velocity_along_it() {
+        // A symmetric landing (the new leg at −a where the old one is at +a, same length) with
+        // the swing thigh at the rate that keeps the hip's forward velocity (found by
+        // linearity, as `generate`'s `neutral_landing_rate`): the whole hip velocity and θ̇2
+        // are then continuous. So the new leg's ẇ⁺ is the old hip velocity along the new leg,
+        // ẇ cos 2a − w θ̇1 sin 2a (independent closed form), and not a product of the impact.
+        let b = Body::from_height(1.5, 60.0).unwrap();
+        let model = StanceModel::new(&b);
+        let old_ankle = [0.0, b.l9];
+        // [w, a, ẇ, θ̇1, θ̇2]: 7 km/h × 1.5 m's heel strike (generated), a slow one, one with
+        // the hip still rising.
+        let cases: [[f64; 5]; 3] = [
+            [0.7582, 0.5845, 1.343, 3.294, -0.751],
+            [0.7480, 0.4365, 0.109, 1.685, -0.080],
+            [0.90, 0.30, 0.60, 0.90, 0.30],
+        ];
+        for [w, a, wd, t1d, t2d] in cases {
+            let old = [w, a, 0.05, wd, t1d, t2d];
+            let (s1, c1) = a.sin_cos();
+            let hip = [old_ankle[0] + w * s1, old_ankle[1] + w * c1];
+            let vh = [wd * s1 + w * t1d * c1, wd * c1 - w * t1d * s1];
+            let new_ankle = [2.0 * w * s1, b.l9];
+            let strike = |rate: f64| {
+                let sw = SwingAtImpact {
+                    hip,
+                    hip_vel: vh,
+                    theta3: [-a + 0.03, rate],
+                };
+                heel_strike(&b, &model, &old, old_ankle, &sw, new_ankle)
+            };
+            let vx =
+                |s: &StanceStart| s.qd[0] * s.q[1].sin() + s.q[0] * s.qd[1] * s.q[1].cos() - vh[0];
+            let (j0, j1) = (vx(&strike(0.0)), vx(&strike(1.0)));
+            let s = strike(-j0 / (j1 - j0));
+            assert!((s.q[0] - w).abs() < 1e-12 && (s.q[1] + a).abs() < 1e-12);
+            let (sn, cn) = s.q[1].sin_cos();
+            let vh2 = [
+                s.qd[0] * sn + s.q[0] * s.qd[1] * cn,
+                s.qd[0] * cn - s.q[0] * s.qd[1] * sn,
+            ];
+            assert!(
+                (vh2[0] - vh[0]).abs() < 1e-9 && (vh2[1] - vh[1]).abs() < 1e-9,
+                "hip velocity {vh:?} → {vh2:?}"
+            );
+            assert!((s.qd[2] - t2d).abs() < 1e-9, "θ̇2 {t2d} → {}", s.qd[2]);
+            let approach = wd * (2.0 * a).cos() - w * t1d * (2.0 * a).sin();
+            assert!(
+                (s.qd[0] - approach).abs() < 1e-9,
+                "ẇ⁺ {} against {approach}",
+                s.qd[0]
+            );
+        }
     }
 
     /// Angular momentum about `pivot` (clockwise positive, like the θ angles) of a body of mass
