@@ -140,6 +140,28 @@ const PARENT: [usize; JOINT_COUNT] = [
     20,
 ];
 
+/// The side a paired joint's or landmark's name gives by its `l_` / `r_` prefix (`None` for
+/// a midline name).
+fn side_of_name(name: &str) -> Option<Side> {
+    if name.starts_with("l_") {
+        Some(Side::Left)
+    } else if name.starts_with("r_") {
+        Some(Side::Right)
+    } else {
+        None
+    }
+}
+
+/// The other side's name of a paired joint's or landmark's name (`l_` ↔ `r_`; `None` for a
+/// midline name).
+fn mirrored_name(name: &str) -> Option<String> {
+    if let Some(rest) = name.strip_prefix("l_") {
+        Some(format!("r_{rest}"))
+    } else {
+        name.strip_prefix("r_").map(|rest| format!("l_{rest}"))
+    }
+}
+
 impl Joint {
     /// Every joint in index (depth-first) order.
     pub const ALL: [Joint; JOINT_COUNT] = [
@@ -213,27 +235,14 @@ impl Joint {
 
     /// The side of a paired joint.
     pub fn side(self) -> Option<Side> {
-        let n = self.name();
-        if n.starts_with("l_") {
-            Some(Side::Left)
-        } else if n.starts_with("r_") {
-            Some(Side::Right)
-        } else {
-            None
-        }
+        side_of_name(self.name())
     }
 
     /// The same joint on the other side (itself for midline joints).
     pub fn mirrored(self) -> Joint {
-        let n = self.name();
-        let other = if let Some(rest) = n.strip_prefix("l_") {
-            format!("r_{rest}")
-        } else if let Some(rest) = n.strip_prefix("r_") {
-            format!("l_{rest}")
-        } else {
-            return self;
-        };
-        Joint::from_name(&other).unwrap_or(self)
+        mirrored_name(self.name())
+            .and_then(|other| Joint::from_name(&other))
+            .unwrap_or(self)
     }
 
     /// Hip, knee, ankle and metatarsal joints of one side.
@@ -384,27 +393,14 @@ impl Landmark {
 
     /// The side of a paired landmark.
     pub fn side(self) -> Option<Side> {
-        let n = self.name();
-        if n.starts_with("l_") {
-            Some(Side::Left)
-        } else if n.starts_with("r_") {
-            Some(Side::Right)
-        } else {
-            None
-        }
+        side_of_name(self.name())
     }
 
     /// The same landmark on the other side (itself for midline landmarks).
     pub fn mirrored(self) -> Landmark {
-        let n = self.name();
-        let other = if let Some(rest) = n.strip_prefix("l_") {
-            format!("r_{rest}")
-        } else if let Some(rest) = n.strip_prefix("r_") {
-            format!("l_{rest}")
-        } else {
-            return self;
-        };
-        Landmark::from_name(&other).unwrap_or(self)
+        mirrored_name(self.name())
+            .and_then(|other| Landmark::from_name(&other))
+            .unwrap_or(self)
     }
 
     /// Heel, ball and toe of one side: the foot's sole points.

@@ -44,6 +44,7 @@
 //! assert!((r.mu(2, x) - r.mu_star()[2]).abs() < 1e-15);
 //! assert_eq!(r.outputs(), 4);
 //! ```
+use super::required;
 use super::{
     expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
@@ -292,13 +293,9 @@ impl Relation for KbMu {
     }
     fn observe_output(&self, row: &FieldValues, k: usize) -> Result<Observation, Rejection> {
         let q = MU_QUANTITIES[k.min(3)];
-        let y = row.get(q).ok_or(Rejection::Missing(q))?;
-        let sl = row
-            .get(Quantity::StepLength)
-            .ok_or(Rejection::Missing(Quantity::StepLength))?;
-        let ll = row
-            .get(Quantity::LegLength)
-            .ok_or(Rejection::Missing(Quantity::LegLength))?;
+        let y = required(row, q)?;
+        let sl = required(row, Quantity::StepLength)?;
+        let ll = required(row, Quantity::LegLength)?;
         if !(ll > 0.0 && sl > 0.0) {
             return Err(Rejection::Invalid(format!(
                 "step length {sl} m and leg length {ll} m must be positive"

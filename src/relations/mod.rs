@@ -187,6 +187,12 @@ pub enum Rejection {
     Invalid(String),
 }
 
+/// The value of quantity `q` in `row`, or the rejection naming it: what every relation's
+/// [`Relation::observe`] asks of a row for each quantity it [`Relation::needs`].
+fn required(row: &FieldValues, q: Quantity) -> Result<f64, Rejection> {
+    row.get(q).ok_or(Rejection::Missing(q))
+}
+
 impl std::fmt::Display for Rejection {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

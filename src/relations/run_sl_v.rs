@@ -19,6 +19,7 @@
 //! assert!((r.step_length(200.0, 1.8, 0.0) - 1.0694).abs() < 1e-9);
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
+use super::required;
 use super::{
     expect_id, linear_gradient, sorted_keys, Citation, CoefficientSet, Domain, KeyRange, KeyScale,
     KeySums, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection, Relation,
@@ -210,15 +211,9 @@ impl Relation for RunSlV {
         &[Quantity::Speed, Quantity::StepLength, Quantity::BodyHeight]
     }
     fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let v = row
-            .get(Quantity::Speed)
-            .ok_or(Rejection::Missing(Quantity::Speed))?;
-        let sl = row
-            .get(Quantity::StepLength)
-            .ok_or(Rejection::Missing(Quantity::StepLength))?;
-        let h = row
-            .get(Quantity::BodyHeight)
-            .ok_or(Rejection::Missing(Quantity::BodyHeight))?;
+        let v = required(row, Quantity::Speed)?;
+        let sl = required(row, Quantity::StepLength)?;
+        let h = required(row, Quantity::BodyHeight)?;
         if h <= 0.0 {
             return Err(Rejection::Invalid(format!(
                 "body height {h} m is not positive"

@@ -30,6 +30,7 @@
 //! assert!((r.flight_time(187.0) - 0.188).abs() < 0.0005); // running paper §3.1
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
+use super::required;
 use super::{
     expect_id, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, KeyRange, KeyScale,
     KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection,
@@ -323,12 +324,8 @@ impl Relation for RunTflightSf {
         &[Quantity::StepFreq, Quantity::FlightTime]
     }
     fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let sf = row
-            .get(Quantity::StepFreq)
-            .ok_or(Rejection::Missing(Quantity::StepFreq))?;
-        let tf = row
-            .get(Quantity::FlightTime)
-            .ok_or(Rejection::Missing(Quantity::FlightTime))?;
+        let sf = required(row, Quantity::StepFreq)?;
+        let tf = required(row, Quantity::FlightTime)?;
         Ok(Observation {
             x: [hz_to_steps_per_min(sf), 0.0, 0.0, 0.0],
             y: tf,

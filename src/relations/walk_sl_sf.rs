@@ -17,6 +17,7 @@
 //! assert!((w.step_freq_for_speed(v, 1.8) - 107.58).abs() < 0.01);
 //! assert!((w.step_length_for_speed(v, 1.8) - 0.7746).abs() < 0.0005);
 //! ```
+use super::required;
 use super::{
     expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Rejection, Relation, RelationError, Variable,
@@ -140,15 +141,9 @@ impl Relation for WalkSlSf {
         ]
     }
     fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let sl = row
-            .get(Quantity::StepLength)
-            .ok_or(Rejection::Missing(Quantity::StepLength))?;
-        let sf = row
-            .get(Quantity::StepFreq)
-            .ok_or(Rejection::Missing(Quantity::StepFreq))?;
-        let h = row
-            .get(Quantity::BodyHeight)
-            .ok_or(Rejection::Missing(Quantity::BodyHeight))?;
+        let sl = required(row, Quantity::StepLength)?;
+        let sf = required(row, Quantity::StepFreq)?;
+        let h = required(row, Quantity::BodyHeight)?;
         Ok(Observation {
             x: [hz_to_steps_per_min(sf), h, 0.0, 0.0],
             y: sl,

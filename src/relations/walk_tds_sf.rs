@@ -16,6 +16,7 @@
 //! // t_ds at 120 steps/min: (29.08 − 19.2) % of a 1 s cycle = 0.0988 s.
 //! assert!((w.double_support_time(120.0) - 0.0988).abs() < 1e-12);
 //! ```
+use super::required;
 use super::{
     expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Rejection, Relation, RelationError, Variable,
@@ -134,12 +135,8 @@ impl Relation for WalkTdsSf {
         &[Quantity::StepFreq, Quantity::DoubleSupportPct]
     }
     fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let sf = row
-            .get(Quantity::StepFreq)
-            .ok_or(Rejection::Missing(Quantity::StepFreq))?;
-        let pct = row
-            .get(Quantity::DoubleSupportPct)
-            .ok_or(Rejection::Missing(Quantity::DoubleSupportPct))?;
+        let sf = required(row, Quantity::StepFreq)?;
+        let pct = required(row, Quantity::DoubleSupportPct)?;
         Ok(Observation {
             x: [hz_to_steps_per_min(sf), 0.0, 0.0, 0.0],
             y: pct,
