@@ -137,8 +137,12 @@ pub struct Closing {
     geo: StopStart,
     stance_leg: VirtualLeg,
     stance_rho: Vec<(f64, f64)>,
-    /// The landing foot's ankle angle θ5 over the first [`EARLY`] s, `(t, θ5)`.
+    /// The landing foot's ankle angle θ5 from the heel strike to [`EARLY`] s after the leg's
+    /// reach, `(t, θ5)`.
     stance_theta5: Vec<(f64, f64)>,
+    /// When the straight leg first reaches the landing foot's pitched ankle, s (the rocker's
+    /// roll starts there; see [`Closing::contact_ankle_rate`]).
+    stance_reach: f64,
     trail_leg: VirtualLeg,
     trail_rho: Vec<(f64, f64)>,
     ankle_x: Quintic,
@@ -244,6 +248,7 @@ impl Closing {
             stance_leg: stance_leg.clone(),
             stance_rho: Vec::new(),
             stance_theta5: Vec::new(),
+            stance_reach: 0.0,
             trail_leg: trail_leg.clone(),
             trail_rho: Vec::new(),
             ankle_x: Quintic::new([0.0; 3], [0.0; 3], 1.0),
@@ -281,16 +286,14 @@ impl Closing {
             })
             .unwrap_or(0);
         stance_leg.plan_heel_rocker(&hips[reach_from..], g.heel_rocker_min);
-        // The early ankle rate the last swing lands into is the rolling rocker's, from the reach
-        // on (see `contact_ankle_rate`).
-        let t_reach = hips[reach_from].0;
+        c.stance_reach = hips[reach_from].0;
         let mut flat = false;
         for &(t, hip, dz) in &hips {
             let rho = if flat {
                 0.0
             } else {
                 let p = stance_leg.advance(t, hip, dz);
-                if (t_reach - 1e-9..=t_reach + EARLY).contains(&t) {
+                if t <= c.stance_reach + EARLY {
                     c.stance_theta5.push((t, p.theta5));
                 }
                 if stance_leg.period != FootPeriod::HeelRocker {
@@ -340,25 +343,27 @@ impl Closing {
         c
     }
 
-    /// The landing foot's mean ankle rate dθ5/dt over the first `window` s of its rolling heel
-    /// rocker (at most `EARLY`, 0.05 s), rad/s: the last step's swing foot lands into it (see
-    /// [`super::swing::SwingFoot::theta5_rate_hs`]), as every step's lands into the next
-    /// step's heel rocker.
+    /// The landing foot's mean ankle rate dθ5/dt from the heel strike to `window` s (at most
+    /// `EARLY`, 0.05 s) after the straight leg reaches its pitched ankle, rad/s: the last step's
+    /// swing foot lands into it (see [`super::swing::SwingFoot::theta5_rate_hs`]), as every
+    /// step's lands into the next step's heel rocker.
     ///
-    /// The window starts where the straight leg first reaches the pitched foot's ankle, not at
-    /// the contact: until then (up to a few ms; the 3-D leg may fall a millimetre short) the
-    /// foot holds its landing pitch while the shank turns over it, θ5 *rising*. Measured from
-    /// the contact, that hold cancelled the roll (4 km/h × 2.0 m: +0.47 rad/s over 10 ms, the
-    /// roll −1.32), so the swing ankle arrived at rest while the stance ankle then turned at
-    /// 1.2 rad/s — 0.012 rad in the first frame against a median of 0.0023 (continuity 5.23;
-    /// 5.34 on 1.5 → 4 km/h × 2.0 m; 3.23 and 3.61 now).
+    /// Why past the reach: until then (2–12 ms; the 3-D leg may fall a millimetre short of the
+    /// sagittal heel-strike geometry) the foot holds its landing pitch while the shank turns over
+    /// it, θ5 *rising*, and only then rolls. Over a fixed `window` from the contact the hold
+    /// could fill most of it and cancel the roll (4 km/h × 2.0 m: hold 8 ms, +0.47 rad/s over
+    /// 10 ms against a roll of −1.32), so the swing ankle arrived at rest while the stance ankle
+    /// then turned 0.012 rad in the first frame against a median of 0.0023 (continuity 5.23;
+    /// 5.34 on 1.5 → 4 km/h × 2.0 m; 3.23 and 3.61 now). Why from the contact, not from the
+    /// reach: the rolling rocker's own early rate (−3 to −4 rad/s at 6–7 km/h, whose roll then
+    /// decays within 2–3 frames) made the swing3 cubic end 4 rad/s into a first stance frame
+    /// that also holds (4 → 7 km/h × 1.8 m 4.62 → 6.08); the mean over the hold and the first
+    /// `window` of roll is what the first drawn step after the contact covers (4.88 there).
     pub fn contact_ankle_rate(&self, window: f64) -> f64 {
         let s = &self.stance_theta5;
-        let t0 = s.first().map_or(0.0, |x| x.0);
-        let (Some(&a), Some(&b)) = (
-            s.first(),
-            s.iter().take_while(|x| x.0 <= t0 + window + 1e-9).last(),
-        ) else {
+        let end = self.stance_reach + window.min(EARLY);
+        let (Some(&a), Some(&b)) = (s.first(), s.iter().take_while(|x| x.0 <= end + 1e-9).last())
+        else {
             return 0.0;
         };
         if b.0 > a.0 {
