@@ -6,13 +6,17 @@
 //!   angle is set, at every evaluation, so that the ankle lies on the 4th-order polynomial `P`
 //!   through the five conditions of §4.3;
 //! - *swing2* (t1 → t2): hip held by a spring–damper about the heel-strike angle (here, with the
-//!   knee brake, about an angle leading it by part of swing3's retraction, [`SWING3_LEAD`]), knee torque
+//!   knee brake, the hip torque follows a terminal-swing path of the thigh, with the
+//!   spring–damper on its error: the thigh stops flexing and starts to retract
+//!   [`RETRACTION_CYCLE`] of the gait cycle before heel strike, as a human thigh does, where the
+//!   paper's stays at the heel-strike angle until the knee locks), knee torque
 //!   `F_θ4 = B·e^{−(t−t1)/τ}`, `B` found so that the knee is straight (`θ4 = 0`) exactly at t2 —
-//!   here plus a terminal knee brake `E·uⁿ` (with a hip-extension share, the hamstrings), `B`
+//!   here plus a terminal knee brake `E·uⁿ` (the hamstrings), `B`
 //!   and `E` found together so that the knee is also at rest at t2 ([`KNEE_BRAKE_POWER`]: the
 //!   paper's knee slams into the lock at 5–7 rad/s);
 //!   if a foot point comes closer to the ground than the toe clearance, a position actuator
-//!   (a temporary forward shift of the hip's set point, `pa3·sin(π·τ)`, here over the first [`RECOVERY_END`] of swing2) is increased step by step
+//!   (a temporary forward shift of the hip's set point, `pa3·sin(π·τ)`, here over the first
+//!   [`RECOVERY_END`] of swing2, at most until the thigh's peak flexion) is increased step by step
 //!   and swing2 repeated — the ground-stubbing recovery;
 //! - *swing3* (t2 → heel strike): the knee is locked straight (the locking impulse conserves the
 //!   thigh's generalized momentum), hip torque `F_θ3 = C·e^{−(t−t2)/τ}`, `C` found so that
@@ -63,8 +67,9 @@ pub struct SwingSpec<'a> {
     pub theta5_max: f64,
     /// Largest integration step, s.
     pub max_step: f64,
-    /// Whether swing2 ends with the knee brought to rest ([`KNEE_BRAKE_POWER`], the recovery's
-    /// shift over [`RECOVERY_END`]) and swing3 lands the thigh at
+    /// Whether swing2 ends with the knee brought to rest ([`KNEE_BRAKE_POWER`]) while the hip
+    /// follows the thigh's terminal-swing path ([`RETRACTION_CYCLE`]; the recovery's shift over
+    /// [`RECOVERY_END`], at most until the path's peak) and swing3 lands the thigh at
     /// [`SwingSpec::theta3_rate_hs`]; otherwise the paper's swing2 and swing3 (one torque each,
     /// the knee locks at whatever rate it reaches).
     ///
@@ -449,17 +454,6 @@ pub const RECOVERY_MAX_RAD: f64 = RECOVERY_MAX as f64 * RECOVERY_STEP;
 /// while the foot is still low and need a larger stubbing recovery.
 pub const KNEE_BRAKE_POWER: i32 = 6;
 
-/// Ratio of the knee brake's hip-extension torque to its knee-flexion torque (the hamstrings'
-/// moment arms, ≈ 6–7 cm at the hip and 3–4 cm at the knee).
-///
-/// Why: the knee torque is internal to the leg, so a brake on the knee alone hands the knee's
-/// momentum to the thigh just like the lock did (the thigh then swung forward at 1.5–1.8 rad/s
-/// at t2 and swing3 had to pull it back, heel-strike thigh rates 3–4 rad/s); a biarticular
-/// brake takes it out at the hip as well. Measured: 1 left the thigh swinging forward at
-/// 0.4–1.1 rad/s at t2, 2 leaves it within ±0.6 rad/s of rest, 3 over-retracted (default-event
-/// heel strikes 25–30 ms late at every speed).
-pub const KNEE_BRAKE_HIP_RATIO: f64 = 2.0;
-
 /// Fraction of swing2 over which the ground-stubbing recovery's set-point shift
 /// `pa·sin(π·u/RECOVERY_END)` acts (the paper's shape spans all of swing2).
 ///
@@ -472,25 +466,135 @@ pub const KNEE_BRAKE_HIP_RATIO: f64 = 2.0;
 /// 0.9 left 1.5 km/h × 1.6 m's double support 42 ms long).
 pub const RECOVERY_END: f64 = 0.85;
 
-/// Fraction of swing3's landing retraction `θ̇3_hs·(t_swing − t2)` ([`SwingSpec::theta3_rate_hs`])
-/// by which swing2's hip set point leads the heel-strike angle at t2 (ramped in over swing2 with
-/// a smoothstep), when the knee is braked: the thigh reaches the knee lock ahead of its landing
-/// angle and retracts into the contact, as a human thigh does in terminal swing.
+/// Time before heel strike at which the swing thigh reaches its peak flexion and starts to
+/// retract, as a fraction of the gait cycle (two steps, `2·t_step`): the knee-braked swing2
+/// follows the terminal-swing path (`ThighPath`, at most [`RETRACTION_SHARE_MAX`] of the time
+/// from the end of swing1 to heel strike).
 ///
-/// Why: swing3 takes the thigh from its state at t2 to `θ3_hs` at `θ̇3_hs`. With the set point at
-/// `θ3_hs` the braked thigh came to t2 only 0.04–0.07 rad ahead of it (behind it at 7 km/h), yet
-/// already retracting at 0.5–0.8 rad/s: less way than a retraction between those two rates
-/// covers, so swing3's torque stopped the thigh and retracted it again (at 7 km/h swung it
-/// forward first). The swing heel slowed to 0.19–0.26 m/s about 1 cm above the floor at t2 and
-/// sped up again by 0.2–1.1 m/s before contact (a stall 9 frames before heel strike at
-/// 1.5 km/h; gaitfit's foot-speed events see the heel through it). A thigh at rest at t2 that
-/// reaches `θ̇3_hs` at a constant acceleration retracts `½·θ̇3_hs·T3`; the spring–damper lags
-/// its ramped set point, hence more. Measured (8 steps, 1–7 km/h × 1.5/1.8/2.0 m, the heel's
-/// forward speed from its late-swing peak to contact): it rose again by up to 0.19–1.08 m/s per
-/// walk, now by at most 0.12 m/s (0 in 22 of 24 walks); 1/2 as a constant offset left up to
-/// 0.13 m/s and raised 7 km/h × 2.0 m's worst continuity ratio 3.61 → 4.28 (an elbow at heel
-/// strike), 3/4 ramped leaves it at 3.80.
-pub const SWING3_LEAD: f64 = 0.75;
+/// Why: a human thigh reaches its peak flexion at ≈ 85 % of the cycle and retracts through
+/// terminal swing into the contact (Winter's hip angle); the swing2 spring held the thigh
+/// forward of its landing angle until the knee lock (85 % of the swing), so the thigh flexed
+/// until ≈ 6 % of the cycle before contact (1–6 km/h, 5 % at 6–7 km/h × 2.0 m, the drawn
+/// thigh's hip–knee line) and the whole retraction to the collision-neutral landing rate
+/// ([`SwingSpec::theta3_rate_hs`], 1–4 rad/s) fell into swing3's 60–110 ms. Measured (8
+/// steps, 1–7 km/h × 1.5/1.8/2.0 m, the drawn thigh's peak before contact): 0.13 puts it at
+/// 10.6–13.3 % of the cycle from 3 km/h up, 9.5–12.4 % at 2 km/h and 8.9–9.6 % at 1 km/h (whose
+/// swing is only 30 % of the cycle: the cap). 0.14 with [`RETRACTION_POWER`] 3 gave 11–14 % but
+/// put `klaw_events`' default double support at 5 km/h × 1.8 m 30.5 ms long (limit 30): the
+/// earlier retraction slows the heel earlier, and the foot-speed detector sees the contact
+/// earlier.
+///
+/// The path's hip torque is the one that gives the thigh the path's acceleration (the knee's
+/// torque given), corrected by the paper's spring–damper (`SwingSpec::hip_spring`, per unit of
+/// the straight leg's inertia) on the error: the plain spring–damper about a moving set point
+/// lagged it by up to 0.09 rad (gravity, the knee's extension and the brake drag the thigh) and
+/// peaked 2–3 frames later. It replaces klawhover's lead of the set point (`SWING3_LEAD`, the
+/// thigh retracted only in swing3) and the knee brake's hip share (`KNEE_BRAKE_HIP_RATIO`, the
+/// hamstrings taking the knee's momentum out at the hip): the path's torque does both.
+pub const RETRACTION_CYCLE: f64 = 0.13;
+
+/// Largest share of the time from the end of swing1 to heel strike that the retraction of the
+/// thigh's terminal-swing path (`ThighPath`) may take; the rest stops the thigh's flexion
+/// (from its rate at the end of swing1, 1–5 rad/s). Binds at 1–2 km/h only. 0.8 and 0.85
+/// raised 2 km/h × 1.8 m's worst continuity ratio 2.82 → 3.8 (the knee in swing2).
+pub const RETRACTION_SHARE_MAX: f64 = 0.75;
+
+/// Power `n` of the retraction of the thigh's terminal-swing path (`ThighPath`):
+/// `θ = θ_peak + Δ·vⁿ`, `v` the fraction of the retraction's time `T_r`, so its rate rises from
+/// rest into the landing rate `θ̇3_hs = n·Δ/T_r`. Measured against 3 and 5: 3 retracts
+/// faster early (the heel slows earlier: `klaw_events`' default double support at 5 km/h ×
+/// 1.8 m 28.6–30.5 ms long, limit 30), 5 brought back a 31 mm rise of the heel before contact
+/// at 5 km/h × 1.8 m; 4 gives 26.0 ms.
+pub const RETRACTION_POWER: f64 = 4.0;
+
+/// The swing thigh's terminal-swing path from the end of swing1 (`t1`, where swing1 left it:
+/// at the heel-strike angle, still flexing) to heel strike (`t3`, at the heel-strike angle and
+/// the landing rate `θ̇3_hs`), which the knee-braked swing2's hip follows:
+/// - from `t1` to the peak at `tp = t3 − T_r` ([`RETRACTION_CYCLE`]) the cubic Hermite that
+///   stops the flexion at `θ_peak`;
+/// - from `tp` the retraction `θ_peak + Δ·vⁿ` ([`RETRACTION_POWER`]) with `Δ = θ̇3_hs·T_r/n`,
+///   so that it lands at `θ̇3_hs` (where that Δ is less than the flexion needs to stop
+///   monotonically, `|θ̇3(t1)|·(tp − t1)/3`, Δ is that and the retraction the cubic Hermite).
+///
+/// Both pieces are monotone, the path C¹ with its only reversal at `tp`.
+#[derive(Debug, Clone, Copy)]
+struct ThighPath {
+    t1: f64,
+    tp: f64,
+    t3: f64,
+    th1: f64,
+    om1: f64,
+    peak: f64,
+    th_hs: f64,
+    rate_hs: f64,
+}
+
+impl ThighPath {
+    /// The path of `spec`'s swing from the thigh's angle `th1` and rate `om1` at the end of
+    /// swing1.
+    fn new(spec: &SwingSpec, th1: f64, om1: f64) -> ThighPath {
+        let [_, t1, _, t3] = spec.times;
+        // Stance time: t3 is the step's duration.
+        let t_r = (RETRACTION_CYCLE * 2.0 * t3).min(RETRACTION_SHARE_MAX * (t3 - t1));
+        let tp = t3 - t_r;
+        let rate_hs = spec.theta3_rate_hs.max(0.0);
+        let delta = (rate_hs * t_r / RETRACTION_POWER).max((-om1).max(0.0) * (tp - t1) / 3.0);
+        ThighPath {
+            t1,
+            tp,
+            t3,
+            th1,
+            om1,
+            peak: spec.theta3_hs - delta,
+            th_hs: spec.theta3_hs,
+            rate_hs,
+        }
+    }
+
+    /// Angle, rate and acceleration at `t`.
+    fn at(&self, t: f64) -> [f64; 3] {
+        if t <= self.tp {
+            return hermite(self.t1, self.tp, [self.th1, self.om1], [self.peak, 0.0], t);
+        }
+        let delta = self.th_hs - self.peak;
+        let t_r = self.t3 - self.tp;
+        let n = if delta > 0.0 {
+            self.rate_hs * t_r / delta
+        } else {
+            0.0
+        };
+        if n < 2.0 {
+            return hermite(
+                self.tp,
+                self.t3,
+                [self.peak, 0.0],
+                [self.th_hs, self.rate_hs],
+                t,
+            );
+        }
+        let v = ((t - self.tp) / t_r).clamp(0.0, 1.0);
+        let p = v.powf(n - 2.0);
+        [
+            self.peak + delta * p * v * v,
+            delta * n * p * v / t_r,
+            delta * n * (n - 1.0) * p / (t_r * t_r),
+        ]
+    }
+}
+
+/// The cubic Hermite from `(value, rate)` `p0` at `a` to `p1` at `b`: value, rate and
+/// acceleration at `t`.
+fn hermite(a: f64, b: f64, p0: [f64; 2], p1: [f64; 2], t: f64) -> [f64; 3] {
+    let big_t = b - a;
+    let s = ((t - a) / big_t).clamp(0.0, 1.0);
+    let (s2, s3) = (s * s, s * s * s);
+    let d = p1[0] - p0[0];
+    let (m0, m1) = (p0[1] * big_t, p1[1] * big_t);
+    let v = p0[0] + d * (3.0 * s2 - 2.0 * s3) + m0 * (s3 - 2.0 * s2 + s) + m1 * (s3 - s2);
+    let dv = d * (6.0 * s - 6.0 * s2) + m0 * (3.0 * s2 - 4.0 * s + 1.0) + m1 * (3.0 * s2 - 2.0 * s);
+    let ddv = d * (6.0 - 12.0 * s) + m0 * (6.0 * s - 4.0) + m1 * (6.0 * s - 2.0);
+    [v, dv / big_t, ddv / (big_t * big_t)]
+}
 
 /// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
 const PEAK_AT: f64 = 0.3;
@@ -754,24 +858,38 @@ impl SwingSpec<'_> {
         let [k3, c3] = self.hip_spring;
         let tau = self.tau[1];
         let th3_hs = self.theta3_hs;
-        let end = if self.knee_brake { RECOVERY_END } else { 1.0 };
-        // The set point leads the heel-strike angle by part of swing3's retraction (see
-        // SWING3_LEAD), ramped in over swing2.
-        let lead = if self.knee_brake {
-            SWING3_LEAD * self.theta3_rate_hs * (self.times[3] - t2)
-        } else {
-            0.0
+        // With the knee brake the hip follows the thigh's terminal-swing path (`ThighPath`),
+        // and the recovery's shift ends by the path's peak flexion (a forward shift later
+        // would delay the retraction); the paper's spring–damper holds the thigh at its
+        // heel-strike angle.
+        let path = self.knee_brake.then(|| ThighPath::new(self, y0[0], y0[2]));
+        let end = match &path {
+            Some(p) => RECOVERY_END.min((p.tp - t1) / (t2 - t1)),
+            None => 1.0,
         };
+        let inertia = self.model.mass_matrix(&[0.0, 0.0])[0][0];
         let f = |t: f64, y: &[f64; 4]| {
             let hip = (self.hip)(t);
             let u = (t - t1) / (t2 - t1);
-            let set = th3_hs
-                - lead * smoothstep(u)
-                - pa * (std::f64::consts::PI * (u / end).min(1.0)).sin();
-            // The knee brake (hamstrings): flexes the knee and extends the hip.
+            let shift = pa * (std::f64::consts::PI * (u / end).min(1.0)).sin();
+            // The knee brake (hamstrings) flexes the knee; with the path the hip torque also
+            // takes out the momentum it hands to the thigh.
             let brake = be[1] * u.powi(KNEE_BRAKE_POWER);
-            let f3 = -k3 * (y[0] - set) - c3 * y[2] + KNEE_BRAKE_HIP_RATIO * brake;
             let f4 = be[0] * (-(t - t1) / tau).exp() + brake;
+            if let Some(p) = &path {
+                // The hip torque that gives the thigh the path's acceleration (the knee's
+                // torque given), corrected by the spring–damper (per unit of the straight
+                // leg's inertia: the same natural frequency and damping) on its error.
+                let [th, thd, thdd] = p.at(t);
+                let a3 = thdd - k3 / inertia * (y[0] - th + shift) - c3 / inertia * (y[2] - thd);
+                let q = [y[0], y[1]];
+                let m = self.model.mass_matrix(&q);
+                let b = self.model.rhs(&q, &[y[2], y[3]], &[0.0, f4], &hip.acc);
+                let a4 = (b[1] - m[1][0] * a3) / m[1][1];
+                return [y[2], y[3], a3, a4];
+            }
+            let set = th3_hs - shift;
+            let f3 = -k3 * (y[0] - set) - c3 * y[2];
             let acc = self
                 .model
                 .accel(&[y[0], y[1]], &[y[2], y[3]], &[f3, f4], &hip.acc, false);
