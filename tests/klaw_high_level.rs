@@ -2,8 +2,10 @@
 use gaitfit::generator::walking::attributes::WalkAttributes;
 use gaitfit::generator::walking::body::Body;
 use gaitfit::generator::walking::high_level::{
-    complete, heel_strike, phase_times, WalkParams, WalkRelations,
+    complete, froude_number, heel_strike, phase_times, walk_run_note, Locomotion, WalkParams,
+    WalkRelations, WALK_RUN_FROUDE,
 };
+use gaitfit::generator::walking::{generate_walk, ramp_schedule, ScheduleEntry, WalkOptions};
 
 const KMH: f64 = 1.0 / 3.6;
 
@@ -152,4 +154,146 @@ fn eq_3_puts_the_swing_heel_on_the_ground_and_mirrors_the_stance_leg() {
         // The foot raises the hip at impact: w > l1 (§3); and |θ3| < θ1 with a dorsiflexed foot.
         assert!(hs.w > b.l1);
     }
+}
+
+/// The walk–run notes of `ramp_schedule` for a schedule of (km/h, steps) at body height `h`.
+fn walk_run_notes(schedule: &[(f64, usize)], h: f64) -> Vec<String> {
+    let opts = WalkOptions {
+        height_m: h,
+        ..Default::default()
+    };
+    let entries: Vec<ScheduleEntry> = schedule
+        .iter()
+        .map(|&(kmh, n)| ScheduleEntry::at_speed(kmh * KMH, n))
+        .collect();
+    let (_, notes) = ramp_schedule(&entries, &opts).unwrap();
+    notes
+        .into_iter()
+        .filter(|n| n.contains("walk-run transition"))
+        .collect()
+}
+
+/// The number printed after `key` in `note`.
+fn number_after(note: &str, key: &str) -> f64 {
+    let i = note
+        .find(key)
+        .unwrap_or_else(|| panic!("{key:?} not in {note}"))
+        + key.len();
+    let s: String = note[i..]
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_digit() || *c == '.')
+        .collect();
+    s.parse()
+        .unwrap_or_else(|_| panic!("no number after {key:?} in {note}"))
+}
+
+#[test]
+fn a_walk_beyond_the_walk_run_transition_is_noted() {
+    // Closed form, independently of the generator's body: l1 = (l3 + l4)·h from table B-1
+    // (0.23669 + 0.24556 of the height), Fr = v²/(g·l1) with g = 9.80665 m/s².
+    let fr_closed = |kmh: f64, h: f64| (kmh * KMH).powi(2) / (9.80665 * (0.23669 + 0.24556) * h);
+    assert!((fr_closed(7.0, 1.5) - 0.533).abs() < 5e-4);
+    let body = Body::from_height(1.5, 70.0).unwrap();
+    assert!((froude_number(7.0 * KMH, body.l1) - fr_closed(7.0, 1.5)).abs() < 1e-9);
+
+    // 7 km/h × 1.5 m (Fr 0.53): one note, naming the entry, speed, height, Fr and the remedies.
+    let notes = walk_run_notes(&[(5.0, 2), (7.0, 4)], 1.5);
+    assert_eq!(notes.len(), 1, "{notes:?}");
+    let n = &notes[0];
+    assert!(n.starts_with("schedule entry 2:"), "{n}");
+    assert!(
+        n.contains("7.00 km/h") && n.contains("body height of 1.5 m"),
+        "{n}"
+    );
+    let fr = number_after(n, "v^2/(g*l1) =");
+    assert!((fr - fr_closed(7.0, 1.5)).abs() < 0.01, "{fr} {n}");
+    assert!(n.contains("gaitfit generate run"), "{n}");
+    // The remedies as printed clear the note: the speed at most, the height at least.
+    let v_max = number_after(n, "at most");
+    let h_min = number_after(n, "at least");
+    assert!(v_max < 7.0 && h_min > 1.5, "{n}");
+    assert!(
+        walk_run_notes(&[(v_max, 4)], 1.5).is_empty(),
+        "{v_max} km/h"
+    );
+    assert!(walk_run_notes(&[(7.0, 4)], h_min).is_empty(), "{h_min} m");
+    assert!(!walk_run_notes(&[(v_max + 0.02, 4)], 1.5).is_empty());
+    assert!(!walk_run_notes(&[(7.0, 4)], h_min - 0.02).is_empty());
+    // An entry without steps is not walked and gets no note.
+    assert!(walk_run_notes(&[(5.0, 2), (7.0, 0)], 1.5).is_empty());
+
+    // Below the transition: 5 km/h × 1.8 m (Fr 0.23), 6 km/h × 2.0 m (Fr 0.29), 7 km/h × 1.8 m
+    // (Fr 0.44).
+    for (kmh, h) in [(5.0, 1.8), (6.0, 2.0), (7.0, 1.8)] {
+        assert!(fr_closed(kmh, h) < WALK_RUN_FROUDE);
+        assert!(
+            walk_run_notes(&[(kmh, 4)], h).is_empty(),
+            "{kmh} km/h × {h} m"
+        );
+    }
+}
+
+#[test]
+fn the_walk_run_boundary_is_exact() {
+    assert_eq!(WALK_RUN_FROUDE, 0.5);
+    let at = |v: f64| Locomotion {
+        speed_m_per_s: v,
+        step_length_m: 0.9,
+        step_freq_steps_per_min: v / 0.9 * 60.0,
+    };
+    // For every body of 1.50–2.00 m the note switches on between two consecutive floats of the
+    // speed: none at the fastest speed with Fr ≤ 0.5, one at the next float, Fr > 0.5. (Fr is
+    // the square of `stance::froude_speed`, and no float squares to exactly 0.5: 1/√2 rounds to
+    // a float whose square is 0.5000000000000001, the float below it to 0.4999999999999999.)
+    for cm in 150..=200 {
+        let h = f64::from(cm) / 100.0;
+        let l1 = Body::from_height(h, 70.0).unwrap().l1;
+        let mut v = (0.5 * 9.80665 * l1).sqrt().next_down().next_down();
+        for _ in 0..8 {
+            if froude_number(v, l1) > WALK_RUN_FROUDE {
+                break;
+            }
+            v = v.next_up();
+        }
+        // v: the slowest float above the transition.
+        let below = v.next_down();
+        assert!(froude_number(v, l1) > WALK_RUN_FROUDE, "{h} m");
+        assert!(froude_number(below, l1) <= WALK_RUN_FROUDE, "{h} m");
+        assert!((froude_number(v, l1) - WALK_RUN_FROUDE).abs() < 1e-14);
+        assert!(walk_run_note(1, &at(below), h, l1).is_none(), "{h} m");
+        assert!(walk_run_note(1, &at(v), h, l1).is_some(), "{h} m");
+    }
+}
+
+#[test]
+fn the_walk_run_note_reaches_the_report_and_the_cli() {
+    // The report and the motion's metadata of a generated walk (it is still generated).
+    let opts = WalkOptions {
+        height_m: 1.5,
+        ..Default::default()
+    };
+    let (motion, report) = generate_walk(&[ScheduleEntry::at_speed(7.0 * KMH, 2)], &opts).unwrap();
+    assert_eq!(report.steps.len(), 2);
+    let noted = |notes: &[String]| notes.iter().any(|n| n.contains("walk-run transition"));
+    assert!(noted(&report.notes), "{:?}", report.notes);
+    assert!(noted(&motion.metadata.notes), "{:?}", motion.metadata.notes);
+    // The CLI prints it to stderr; not at 7 km/h × 1.8 m.
+    let dir = tempfile::tempdir().unwrap();
+    let stderr = |h: &str| {
+        let out = assert_cmd::Command::cargo_bin("gaitfit")
+            .unwrap()
+            .current_dir(dir.path())
+            .args(["generate", "walk", "--speed", "7km/h", "--height", h])
+            .args(["--seconds", "1", "-o", "walk.csv"])
+            .assert()
+            .success();
+        String::from_utf8_lossy(&out.get_output().stderr).to_string()
+    };
+    let err = stderr("1.5");
+    assert!(
+        err.contains("note: schedule entry 1:") && err.contains("walk-run transition"),
+        "{err}"
+    );
+    assert!(!stderr("1.8").contains("walk-run"));
 }

@@ -9,7 +9,9 @@ use super::body::Body;
 use crate::generator::GenerateError;
 use crate::relations::walk_sl_sf::WalkSlSf;
 use crate::relations::walk_tds_sf::WalkTdsSf;
-use crate::units::{hz_to_steps_per_min, m_per_min_to_m_per_s, m_per_s_to_m_per_min};
+use crate::units::{
+    hz_to_steps_per_min, km_per_h_to_m_per_s, m_per_min_to_m_per_s, m_per_s_to_m_per_min,
+};
 use std::path::Path;
 
 /// The two walking relations KLAW uses, from the relations layer: eq. (1) `sl / (sf·h) = k`
@@ -238,6 +240,62 @@ pub fn check_limits(
         ));
     }
     Ok(())
+}
+
+/// Froude number `v²/(g·l)` above which people change from walking to running: 0.5.
+///
+/// Alexander (1989, "Optimization and gaits in the locomotion of vertebrates", Physiol. Rev.
+/// 69) puts the walk–run transition of humans and other animals near 0.5; Kram, Domingo &
+/// Ferris (1997, J. Exp. Biol. 200) measured 0.5 at normal gravity; Thorstensson & Roberthson
+/// (1987) measured ≈ 2.0–2.2 m/s in adults. Eq. (1) has no such bound and completes a walk
+/// there (7 km/h × 1.5 m: Fr 0.53, a step of 1.16 × the leg), so [`crate::generator::walking::generate_walk`]
+/// says so in its report's notes ([`walk_run_note`]); the walk is still generated.
+///
+/// `l` is the stance model's leg `l1` (hip to ankle, [`Body::l1`]), as in
+/// [`super::stance::froude_speed`]; the sources use the hip height, ≈ 8 % longer (l9 + l1), so
+/// gaitfit's Froude number is ≈ 8 % higher and the note comes a little early (at 1.8 m:
+/// 7.4 km/h against 7.7 km/h) — chosen to reuse the leg the stance model scales on.
+pub const WALK_RUN_FROUDE: f64 = 0.5;
+
+/// Froude number `v²/(g·l1)` of a walk at `speed` m/s with a leg `l1` m long: the square of
+/// [`super::stance::froude_speed`].
+pub fn froude_number(speed: f64, l1: f64) -> f64 {
+    super::stance::froude_speed(speed, l1).powi(2)
+}
+
+/// The note for schedule entry `entry` (1-based) walking at `l` with a body of height
+/// `height_m` and leg `l1` (the stance model's, [`Body::l1`]) when its Froude number
+/// ([`froude_number`]) exceeds [`WALK_RUN_FROUDE`]: the entry, its speed, the body height, the
+/// Froude number and the remedies (a slower speed, a taller body, or `gaitfit generate run`).
+/// `None` at or below the transition.
+///
+/// ```
+/// use gaitfit::generator::walking::high_level::{walk_run_note, Locomotion};
+/// let l = Locomotion { speed_m_per_s: 7.0 / 3.6, step_length_m: 0.84, step_freq_steps_per_min: 139.0 };
+/// let note = walk_run_note(2, &l, 1.5, 0.7234).unwrap();
+/// assert!(note.contains("schedule entry 2") && note.contains("0.53"));
+/// assert!(walk_run_note(2, &l, 1.8, 0.868).is_none()); // Fr 0.44
+/// ```
+pub fn walk_run_note(entry: usize, l: &Locomotion, height_m: f64, l1: f64) -> Option<String> {
+    let v = l.speed_m_per_s;
+    let fr = froude_number(v, l1);
+    if fr.is_nan() || fr <= WALK_RUN_FROUDE {
+        return None;
+    }
+    let kmh = |v: f64| v / km_per_h_to_m_per_s(1.0);
+    // Fr ∝ v², and ∝ 1/h since l1 is a fixed fraction of the body height (table B-1).
+    // Rounded to the printed digits on the safe side: the remedy as printed clears the note.
+    let v_max_kmh = (kmh(v * (WALK_RUN_FROUDE / fr).sqrt()) * 100.0).floor() / 100.0;
+    let h_min = (height_m * fr / WALK_RUN_FROUDE * 100.0).ceil() / 100.0;
+    Some(format!(
+        "schedule entry {entry}: {:.2} km/h ({v:.3} m/s) for a body height of {height_m} m is beyond \
+         the walk-run transition: Froude number v^2/(g*l1) = {fr:.3} > WALK_RUN_FROUDE = \
+         {WALK_RUN_FROUDE} (leg l1 = {l1:.4} m, step {:.2} x l1), where people run; the walk is \
+         generated but strained. Walk at most {v_max_kmh:.2} km/h, give a body of at least \
+         {h_min:.2} m, or use `gaitfit generate run`",
+        kmh(v),
+        l.step_length_m / l1,
+    ))
 }
 
 /// The state-phase timings of one step (eq. 2), seconds.

@@ -19,6 +19,16 @@
 //! The virtual leg, kinematic feet, spine and arms then dress the dynamics, and the result is the
 //! shared [`Motion`] (exported as BVH, CSV or TRC by [`crate::export::motion::write`]).
 //!
+//! **Continuity caveat.** Steady walks of 1–7 km/h × 1.5–2.0 m meet the smoothness check
+//! [`crate::generator::checks::continuity`] at k = 5 (every frame-to-frame step within 5 × the
+//! median of its neighbours), except 7 km/h × 1.5 m: 5.29 steady (the ankle at every heel
+//! strike), 5.62 from standing; from standing 4 km/h × 1.5 m also reaches 5.17 (measured on
+//! main b68aea6, 8 steps, 100 frames/s). 7 km/h × 1.5 m is measured *above the walk–run
+//! transition*: its Froude number `v²/(g·l1)` is 0.53 > [`high_level::WALK_RUN_FROUDE`]
+//! (eq. 1 gives it a step of 1.16 × the leg, an inter-leg angle of 67° at heel strike), a
+//! speed at which a person of that height runs; its report carries a note saying so
+//! ([`high_level::walk_run_note`]).
+//!
 //! The equations of motion are checked against an independent Lagrangian derivation
 //! ([`lagrange`]); the corrections to the printed equations are listed in [`dynamics`]. The
 //! integrator and its stability argument are in [`integrate`].
@@ -106,7 +116,8 @@ pub fn steps_for_duration(
 ///
 /// A change of speed between stretches larger than the attribute `max_speed_change_m_per_s`
 /// (per step) is ramped ([`ramp_schedule`]); the walk's `metadata.notes` and the report's notes
-/// say where.
+/// say where. They also name every stretch commanded beyond the walk–run transition (Froude
+/// number above [`high_level::WALK_RUN_FROUDE`]), which is walked all the same.
 pub fn generate_walk(
     schedule: &[ScheduleEntry],
     opts: &WalkOptions,
@@ -147,7 +158,8 @@ pub fn generate_walk(
 /// n = ⌈|Δv| / limit⌉ steps at equal increments of speed (the paper changes speed in one step,
 /// §2.4, whatever the size: no one changes walking speed by 1.7 m/s in one step, and the
 /// generator breaks the continuity check from about 1.1 m/s per step). Returns the steps and
-/// one note per ramped change.
+/// the notes: one per ramped change, and one per entry (with steps) whose Froude number exceeds
+/// [`high_level::WALK_RUN_FROUDE`] ([`high_level::walk_run_note`]: it is walked all the same).
 ///
 /// - The ramp's n − 1 intermediate steps are taken out of the new stretch, so that the schedule
 ///   keeps its step count (and a duration its time). A stretch shorter than its ramp ramps all
@@ -176,12 +188,17 @@ pub fn ramp_schedule(
     let complete =
         |p: &WalkParams| high_level::complete(p, opts.height_m, &opts.relations, &opts.attributes);
     let limit = opts.attributes.max_speed_change_m_per_s;
+    // The stance model's leg (generate::generate_steps builds the same body).
+    let l1 = body::Body::from_height(opts.height_m, opts.mass_kg)?.l1;
     let mut steps: Vec<Locomotion> = Vec::new();
     let mut notes = Vec::new();
     // Whether the last step walked naturally at its speed (given by its speed alone).
     let mut last_natural = true;
     for (i, e) in schedule.iter().enumerate() {
         let target = complete(&e.params).map_err(|err| entry_err(i, "", err))?;
+        if e.steps > 0 {
+            notes.extend(high_level::walk_run_note(i + 1, &target, opts.height_m, l1));
+        }
         let natural =
             e.params.step_length_m.is_none() && e.params.step_freq_steps_per_min.is_none();
         let mut left = e.steps;
