@@ -66,7 +66,9 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
 /// the projected length with the leg spring's rest length shortened
 /// (`generate::REST_SHORTENING_FROUDE_MAX`, `StanceSpec::rest_length`): 3.97/4.89/5.53 → 0.00/0.04/0.29 mm
 /// (0.39/0.41/0.77 with the lock alone). The walks below Froude 0.16 (1 km/h) keep the hover
-/// (2.3–3.5 mm): asserted above 1 mm so that a fix there is noticed.
+/// (4.07/3.17/3.52 mm since the knee ease carries a flexing rocker landing's rate on,
+/// `virtual_leg::KNEE_ROCKER_EASE`; 2.32/3.17/3.52 before): asserted above 1 mm so that a fix
+/// there is noticed.
 ///
 /// Where the heel stays down it rises (1 mm) at 34–43 % of the gait cycle (2 km/h 34–37 %,
 /// 3 km/h 37–39 %, 5 km/h 39–42 %, 7 km/h 41–43 %): a human's heel off is at 30–40 %, so up to

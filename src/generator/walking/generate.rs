@@ -319,6 +319,18 @@ fn num_err(stage: String, message: String) -> GenerateError {
 /// (the paper's rest length) does not reach there: the leg lands longer than `l1` and locks
 /// where it turns, above the projected lock ([`super::stance::StanceSpec::rest_length`]). It
 /// was 0.24 (3 km/h walks and up) before the rest length.
+///
+/// Re-measured since the knee ease carries the rocker's landing rate
+/// (`virtual_leg::KNEE_ROCKER_EASE`), with the lock and the rest length from Froude 0 (1 km/h
+/// heel, highest from foot flat to heel off / midstance, 1.5/1.8/2.0 m; worst continuity of
+/// 1 km/h × 8 steps; default t_ds at 1.5 km/h × 1.6 m, +13.5 ms without): the same 20 % ramp
+/// 1.11/1.84/2.02 mm, 4.94/3.75/3.41, +24.9 ms; klawhover's 10 % ramp 1.39/1.13/1.17 mm,
+/// 4.65/3.83/3.52 (no 9.08 any more), +32.5 ms, but 1.25 km/h × 1.7 m 5.13; twice the reach
+/// over 10 % of the stance keeps the heel down (0.00/0.02/0.09 mm, rising at 33–36 % of the
+/// cycle), +35.7 ms, but 1 km/h 4.77/4.15/3.93 and from standing with a stop 1 km/h × 1.5 m
+/// 10.06 (the landing knee of the last step before the stop, whose stance keeps the paper's
+/// lock), 1.5 km/h × 2.0 m 24.7 (steady, frame 48: the first trailing leg, whose pre-roll
+/// stance reached no meta off before toe off). None is taken yet.
 pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.16;
 
 /// Froude speed below which a stance that locks at the projected length

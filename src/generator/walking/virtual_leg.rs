@@ -76,7 +76,12 @@ pub const KNEE_LAND_EASE: f64 = 0.03;
 /// Easing every rocker's knee this way (not only narrowed ones) spoiled faster walks (7 km/h ×
 /// 1.5 m 5.29 → 18.1, 4 km/h × 1.5 m 3.75 → 5.22); easing only the landings below
 /// [`KNEE_EASE_SOFT`] left 1 km/h × 1.6 m's knee stopping dead at heel off (6.81; its landing
-/// narrows the margin to ≈ 0.6 mm).
+/// narrows the margin to ≈ 0.6 mm). Cost: where the landing knee still *flexes* (1 km/h ×
+/// 1.5 m, ≈ 4 rad/s) the ease carries it on past the rule's peak (0.18 rad against 0.135), the
+/// foot rolls for it and, its roll never decreasing, keeps the heel 4.07 mm up through
+/// midstance (2.32 mm before; 1.8/2.0 m unchanged, 3.17/3.52). A 15 ms ease for flexing
+/// landings only, or no rocker ease for them, put 1 km/h × 1.5 m from standing at 5.25, 1.5
+/// km/h × 1.5 m at 6.27 (steady) or left 1.6 m at 6.81.
 pub const KNEE_ROCKER_EASE: f64 = 0.05;
 
 /// The knee was eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
