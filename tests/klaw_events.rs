@@ -6,9 +6,10 @@
 //!   foot-speed detector — Zeni windows refined by the heel and toe speed over the ground,
 //!   Bonci et al. 2022 —, 6 Hz marker filter): mean step length and frequency within 1 %, every
 //!   steady step's length within 1 %, and the double support within 3 frames (or 10 %) of t_ds
-//!   at 1.5, 3, 5 and 7 km/h (measured +20, +17, +19 and +7 ms since the swing heel slows
-//!   monotonically into the contact, `swing::SWING3_LEAD`: −3, +7, +12 and 0 ms before, when it
-//!   stalled and sped up again in late swing; the Zeni coordinate method gave +31 % at 7 km/h). 1.5 and 3 km/h used to come out +43 % and +28 % long: the meta-off knee
+//!   at 1.5, 3, 5 and 7 km/h (measured +12.8, +12.4, +26.0 and +17.3 ms on main 42fbe9a, with
+//!   the landing thigh retracting through terminal swing, `swing::RETRACTION_CYCLE`; −3, +7, +12
+//!   and 0 ms when the swing heel still stalled and sped up again in late swing; the Zeni
+//!   coordinate method gave +31 % at 7 km/h). 1.5 and 3 km/h used to come out +43 % and +28 % long: the meta-off knee
 //!   blend ended at rest, so the swing foot left the floor with almost no speed and no speed
 //!   criterion could see it leave; the knee now leaves toe off flexing at up to
 //!   `virtual_leg::TOE_OFF_KNEE_RATE` (8 rad/s), the swing2 knee brake takes the faster swing's
@@ -267,7 +268,8 @@ fn a_steady_walk_starts_and_ends_mid_motion() {
     }
 }
 
-/// The swing heel's approach to heel strike (issue 6, `swing::SWING3_LEAD`): from its
+/// The swing heel's approach to heel strike (issue 6, `swing::RETRACTION_CYCLE`, which replaced
+/// session 8's `SWING3_LEAD`): from its
 /// late-swing peak (second half of the swing) the heel's forward speed over the ground falls
 /// all the way to contact — it never speeds up again by more than 0.05 m/s — and from the knee
 /// lock (the knee straight, the end of swing2) to contact the heel only descends (0.1 mm).
