@@ -474,6 +474,28 @@ fn a_slow_walk_lands_flat_without_a_heel_pop() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// Slow walks between the grid points (steady start, 8 steps): at the switch from heel off to
+/// meta-off the foot's roll dropped back from the heel-off rule's roll to `meta_off_rho`, moving
+/// the ankle away from the hip within one 2 ms sample; the nearly straight knee straightened by
+/// up to 0.014 rad there, drawn directly (1.2 km/h × 1.7 m 6.14, frame 602, l_knee, every step)
+/// or, where the switch fell on the toe-off sample, as the swing's starting rates (1.25 km/h ×
+/// 1.8 m 11.14, frame 59, r_knee, swing1's thigh torque −114 against −30 at the later steps;
+/// 1.4 km/h × 2.0 m 5.66, frame 49, r_ankle). Meta-off now starts from the rule's roll
+/// (diagnosis: klawdiag, session 9). Measured 4.14 (frame 337, r_knee), 3.74 (15, l_ankle),
+/// 3.99 (571, r_ankle): k = 5 met.
+#[test]
+fn meta_off_starts_from_the_heel_off_roll() {
+    let mut failures = Vec::new();
+    for (v, h) in [(1.2, 1.7), (1.25, 1.8), (1.4, 2.0)] {
+        let (w, r) = worst(&[(v, 8)], h, false);
+        println!("{v} km/h x {h} m: {r}");
+        if w > ContinuityOptions::default().k {
+            failures.push(format!("{v} km/h x {h} m: {r}"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// Slowing 7 → 1 km/h (4 steps each, from standing, with a stop; ramped 7 → 5.5 → 4 → 2.5 →
 /// 1 km/h) at 2.0 m: the slow steps' ankle leaves the ground high and the swing1 ankle curve's
 /// far flank was as steep as the ankle's reach about the knee (73.5 at frame 498, l_knee, before
