@@ -26,7 +26,7 @@ mod common;
 
 use common::{joint_angles, joint_steps};
 use gaitfit::events::EventKind;
-use gaitfit::generator::checks::{continuity, continuity_over, ContinuityOptions};
+use gaitfit::generator::checks::{continuity, continuity_over, step_ratios, ContinuityOptions};
 use gaitfit::generator::motion::Motion;
 use gaitfit::generator::skeleton::Joint;
 use gaitfit::generator::walking::generate_walk;
@@ -644,22 +644,10 @@ fn contact_ratio(m: &Motion, joint_of: impl Fn(gaitfit::events::Side) -> Joint) 
     let mut worst: f64 = 0.0;
     let contacts = contact_frames(m);
     for &(f, side) in &contacts {
-        let s = joint_steps(m, joint_of(side));
-        for i in f - 3..=f + 2 {
-            // The window as `checks::continuity` takes it: cut at the first frame.
-            let mut nb: Vec<f64> = s[i.saturating_sub(3)..i]
-                .iter()
-                .chain(&s[i + 1..i + 4])
-                .copied()
-                .collect();
-            nb.sort_by(f64::total_cmp);
-            let n = nb.len();
-            let median = if n % 2 == 1 {
-                nb[n / 2]
-            } else {
-                0.5 * (nb[n / 2 - 1] + nb[n / 2])
-            };
-            worst = worst.max(s[i] / median.max(1e-3));
+        // The ratio as `checks::continuity` takes it (window 3, floor 1e-3 rad).
+        let r = step_ratios(&joint_steps(m, joint_of(side)), 3, 1e-3);
+        for ratio in r[f - 3..=f + 2].iter().flatten() {
+            worst = worst.max(*ratio);
         }
     }
     (worst, contacts.len())

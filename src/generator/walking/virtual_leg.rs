@@ -1289,22 +1289,9 @@ mod tests {
     /// against the median of the 3 on each side, floored) of a series sampled every 10 ms.
     fn worst_step_ratio(v: &[f64], floor: f64) -> f64 {
         let steps: Vec<f64> = v.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-        (0..steps.len())
-            .map(|i| {
-                let mut nb: Vec<f64> = steps[i.saturating_sub(3)..i]
-                    .iter()
-                    .chain(&steps[i + 1..(i + 4).min(steps.len())])
-                    .copied()
-                    .collect();
-                nb.sort_by(f64::total_cmp);
-                let k = nb.len();
-                let med = if k % 2 == 1 {
-                    nb[k / 2]
-                } else {
-                    0.5 * (nb[k / 2 - 1] + nb[k / 2])
-                };
-                steps[i] / med.max(floor)
-            })
+        crate::generator::checks::step_ratios(&steps, 3, floor)
+            .into_iter()
+            .flatten()
             .fold(0.0, f64::max)
     }
 
