@@ -116,11 +116,21 @@ pub const ROCKER_SCAN: usize = 4;
 
 /// How much gentler (peak knee acceleration, [`ROCKER_SCAN`]'s cost) a landing must be to replace
 /// a kept landing whose knee dips (flexes, straightens and flexes again) against the knee-ease
-/// rule there. Why: the first slower stance of a slow-down trades a dipping eased landing for one
-/// 21–700 × gentler (3 → 1 km/h × 1.8 m 10.6 → 4.2); steady 1 km/h walks at 1.7 m have a
-/// shallower dip with a landing only 5.3 × gentler, and trading it made their knee straighten
-/// abruptly at heel off (6.0 → 7.35).
-pub const DIP_TRADE: f64 = 10.0;
+/// rule there.
+///
+/// Why: a dipping knee is a jolt at heel strike or foot flat wherever it is kept. The first
+/// slower stance of a slow-down trades it for a landing 21–700 × gentler (3 → 1 km/h × 1.8 m
+/// 10.6 → 4.2); between the tested speeds and heights the gentler landings are only 4–9 ×
+/// gentler (1.3 km/h × 1.5 m: the dipping landing 349, the others 76, 104, 37, 78), and at the
+/// former 10 the dip was kept. Measured, 1.0–2.5 km/h every 0.05 × 1.5–2.0 m every 5 cm, 8 steps
+/// (341 walks), walks over k = 5 and the worst ratio: 10 → 17 (11.35), 5 → 3 (8.13), 4, 3, 2.5, 2
+/// and 1.5 → none (4.78, the same walks identical from 4 down); from standing with a stop, every
+/// 0.1 km/h (176 walks): 15 (12.43) → 1 (5.14, the stop's landing ankle, which this does not
+/// touch). Above 2.5 km/h nothing changed (2.5–7 km/h every 0.1, 506 walks). 3 sits in the
+/// middle of that plateau. (At 5.3 × it had once made 1 km/h × 1.7 m's knee straighten abruptly
+/// at heel off, 6.0 → 7.35; that was before meta-off started from the heel-off roll: now 3.72 →
+/// 3.15.) Tested by `slow_walks_between_the_grid_points_meet_k5` in `tests/klaw_continuity.rs`.
+pub const DIP_TRADE: f64 = 3.0;
 
 /// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow):
 /// the meta-off knee blend ends at this rate instead of at rest.
