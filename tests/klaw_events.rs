@@ -6,7 +6,10 @@
 //!   foot-speed detector — Zeni windows refined by the heel and toe speed over the ground,
 //!   Bonci et al. 2022 —, 6 Hz marker filter): mean step length and frequency within 1 %, every
 //!   steady step's length within 1 %, and the double support within 3 frames (or 10 %) of t_ds
-//!   at 1.5, 3, 5 and 7 km/h (measured +12.8, +12.4, +26.0 and +17.3 ms on main 42fbe9a, with
+//!   at 1.5, 3, 5 and 7 km/h (measured +32.3, +12.4, +26.3 and +17.8 ms since the slowest
+//!   stances lower the hip, `generate::SLOW_REST_REACH`: 1.5 km/h was +12.8 — the lower hip
+//!   through the double support sees the heel strike earlier and the toe off later, within the
+//!   10 % = 36.6 ms allowed there; +12.8, +12.4, +26.0 and +17.3 ms on main 42fbe9a, with
 //!   the landing thigh retracting through terminal swing, `swing::RETRACTION_CYCLE`; −3, +7, +12
 //!   and 0 ms when the swing heel still stalled and sped up again in late swing; the Zeni
 //!   coordinate method gave +31 % at 7 km/h). 1.5 and 3 km/h used to come out +43 % and +28 % long: the meta-off knee

@@ -60,15 +60,15 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
 /// later of heel off and midstance, 1.5/1.8/2.0 m, with the paper's sagittal lock at the straight
 /// leg's length: 3 km/h 3.98/4.90/5.54 mm, 5 km/h 4.01/4.94/5.58, 7 km/h 4.24/5.14/5.75 (heel
 /// off 9–28 frames before midstance). With the projected lock (Froude 0.24–0.65,
-/// `generate::PROJECTED_LOCK_FROUDE_MIN`/`MAX`): ≤ 0.01 mm at 3–6 km/h and 7 km/h × 2.0 m.
+/// `generate::PROJECTED_LOCK_FROUDE_MAX`): ≤ 0.01 mm at 3–6 km/h and 7 km/h × 2.0 m.
 /// Above Froude 0.65 (7 km/h × 1.5/1.8 m) the drawn midstance knee takes the 3-D reach
 /// instead (`StanceSpec::flat_reach`): 4.24/5.14 → 0.00 mm. 2 km/h (Froude 0.19–0.21) locks at
 /// the projected length with the leg spring's rest length shortened
 /// (`generate::REST_SHORTENING_FROUDE_MAX`, `StanceSpec::rest_length`): 3.97/4.89/5.53 → 0.00/0.04/0.29 mm
-/// (0.39/0.41/0.77 with the lock alone). The walks below Froude 0.16 (1 km/h) keep the hover
-/// (4.07/3.17/3.52 mm since the knee ease carries a flexing rocker landing's rate on,
-/// `virtual_leg::KNEE_ROCKER_EASE`; 2.32/3.17/3.52 before): asserted above 1 mm so that a fix
-/// there is noticed.
+/// (0.39/0.41/0.77 with the lock alone). The walks below Froude 0.16 (1 km/h) hovered
+/// 4.07/3.17/3.52 mm (1.0–1.8 km/h: 3.0–5.8 mm) until those stances also locked at the projected
+/// length with twice its reach off the rest length (`generate::SLOW_REST_REACH`): 0.00/0.02/0.09
+/// mm, the heel rising at 33–36 % of the cycle. Every speed is asserted now.
 ///
 /// Where the heel stays down it rises (1 mm) at 34–43 % of the gait cycle (2 km/h 34–37 %,
 /// 3 km/h 37–39 %, 5 km/h 39–42 %, 7 km/h 41–43 %): a human's heel off is at 30–40 %, so up to
@@ -76,7 +76,6 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
 #[test]
 fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
     let mut failed = Vec::new();
-    let mut still = Vec::new();
     for kmh in [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0] {
         for h in [1.5, 1.8, 2.0] {
             let (worst, lead, n, rise) = heel_hover(kmh, h);
@@ -88,11 +87,10 @@ fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
                 100.0 * rise[0],
                 100.0 * rise[1]
             );
-            let fixed = kmh >= 2.0;
-            // Where the heel stays down, it rises where a human's does (30–40 % of the
-            // cycle), a little late at speed.
+            // The heel stays down and rises where a human's does (30–40 % of the cycle), a
+            // little late at speed.
             let timed = rise[0] >= 0.30 && rise[1] <= 0.45;
-            if n < 6 || (fixed && (worst > 1e-3 || !timed)) {
+            if n < 6 || worst > 1e-3 || !timed {
                 failed.push(format!(
                     "{kmh} km/h × {h} m: {:.2} mm, {n} stances, heel up at {:.2}–{:.2}",
                     1e3 * worst,
@@ -100,17 +98,57 @@ fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
                     rise[1]
                 ));
             }
-            if !fixed && worst <= 1e-3 {
-                still.push(format!("{kmh} km/h × {h} m"));
-            }
         }
     }
     assert!(
         failed.is_empty(),
         "stance heel up before heel off: {failed:?}"
     );
+}
+
+/// Between the grid points of the slow walks (1.0–2.0 km/h every 0.1 × 1.5–2.0 m every 5 cm,
+/// 121 steady walks of 8 steps) the stance heel stays within 1 mm of the floor from foot flat to
+/// heel off / midstance. Measured on main 9c72f4f (before `generate::SLOW_REST_REACH`): 83 of the
+/// 121 walks hovered 1.5–6.1 mm (1.0–1.8 km/h; 1.5 km/h × 1.5 m 5.78 mm); now one, listed in
+/// `KNOWN` with its bound (its landing knee flexes 0.27 rad and the ankle meets its
+/// dorsiflexion limit at foot flat: heel off 1 frame after foot flat).
+#[test]
+#[ignore = "slow (121 walks, ≈ 5 s in release on 2 cores); CI runs it with --ignored"]
+fn the_slow_stance_heel_stays_down_between_the_grid_points() {
+    // (km/h, height): measured highest heel, m.
+    const KNOWN: &[(f64, f64, f64)] = &[(1.4, 1.6, 0.00399)];
+    let cases: Vec<(f64, f64)> = (0..=10)
+        .flat_map(|i| (0..=10).map(move |j| (1.0 + 0.1 * f64::from(i), 1.5 + 0.05 * f64::from(j))))
+        .collect();
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let failures = std::sync::Mutex::new(Vec::new());
+    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(&(kmh, h)) = cases.get(i) else {
+                    break;
+                };
+                let (worst, _, n, _) = heel_hover(kmh, h);
+                let bound = KNOWN
+                    .iter()
+                    .find(|k| (k.0 - kmh).abs() < 1e-6 && (k.1 - h).abs() < 1e-6)
+                    .map_or(1e-3, |k| 1.05 * k.2);
+                if n < 6 || worst > bound {
+                    failures.lock().unwrap().push(format!(
+                        "{kmh:.1} km/h × {h:.2} m: heel {:.2} mm, {n} stances",
+                        1e3 * worst
+                    ));
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap();
     assert!(
-        still.is_empty(),
-        "heel now down (move into the asserted set): {still:?}"
+        failures.is_empty(),
+        "{} of {} walks: {failures:#?}",
+        failures.len(),
+        cases.len()
     );
 }

@@ -305,36 +305,33 @@ fn num_err(stage: String, message: String) -> GenerateError {
     GenerateError::Numerical { stage, message }
 }
 
-/// Froude speed `v/√(g·l1)` from which the stance leg locks at the sagittal projection of the
-/// drawn 3-D leg (`StanceSpec::lock_reach`; ≈ 1.7 km/h at 1.8 m), below
-/// [`REST_SHORTENING_FROUDE_MAX`] with the leg spring's rest length shortened as well.
+/// How many times the projected reach (`StanceSpec::flat_reach`) the leg spring's rest length is
+/// shortened by in the slowest walks (Froude speed `v/√(g·l1)` up to [`SLOW_REST_FROUDE`]`[0]`),
+/// blending (smoothstep in Froude) to once the reach at [`SLOW_REST_FROUDE`]`[1]` and above.
 ///
-/// Why not below (1–1.5 km/h; measured, 8 steps, with the shortened rest length ramped in over
-/// 10 % of the stance): the 1 km/h ×
-/// 1.5 m walk's landing knee jumped (4.24 → 9.08, frame 688, l_knee) and gaitfit's default
-/// (foot-speed) double support at 1.5 km/h × 1.6 m (Froude 0.15) came out +39 ms long against
-/// its 36.6 ms limit (`tests/klaw_events.rs`; +20 ms without: the heel strike is seen earlier
-/// and the toe off later with the lower hip through the double support), so those walks keep
-/// the paper's lock and their stance heel still hovers 2.3–3.5 mm at 1 km/h. The lock alone
-/// (the paper's rest length) does not reach there: the leg lands longer than `l1` and locks
-/// where it turns, above the projected lock ([`super::stance::StanceSpec::rest_length`]). It
-/// was 0.24 (3 km/h walks and up) before the rest length.
-///
-/// Re-measured since the knee ease carries the rocker's landing rate
-/// (`virtual_leg::KNEE_ROCKER_EASE`), with the lock and the rest length from Froude 0 (1 km/h
-/// heel, highest from foot flat to heel off / midstance, 1.5/1.8/2.0 m; worst continuity of
-/// 1 km/h × 8 steps; default t_ds at 1.5 km/h × 1.6 m, +13.5 ms without): the same 20 % ramp
-/// 1.11/1.84/2.02 mm, 4.94/3.75/3.41, +24.9 ms; klawhover's 10 % ramp 1.39/1.13/1.17 mm,
-/// 4.65/3.83/3.52 (no 9.08 any more), +32.5 ms, but 1.25 km/h × 1.7 m 5.13; twice the reach
-/// over 10 % of the stance keeps the heel down (0.00/0.02/0.09 mm, rising at 33–36 % of the
-/// cycle), +35.7 ms, but 1 km/h 4.77/4.15/3.93 and from standing with a stop 1 km/h × 1.5 m
-/// 10.06 (the landing knee of the last step before the stop, whose stance keeps the paper's
-/// lock), 1.5 km/h × 2.0 m 24.7 (steady, frame 48: the first trailing leg, whose pre-roll
-/// stance reached no meta off before toe off). None is taken yet.
-pub const PROJECTED_LOCK_FROUDE_MIN: f64 = 0.16;
+/// Why: below Froude 0.16 (≈ 1.7 km/h at 1.8 m) the leg lands 12–14 mm longer than `l1` and
+/// turns within a millimetre of it, so the stance locked at the paper's straight leg and the
+/// drawn 3-D leg could not reach its flat foot: the stance heel rose at once after foot flat
+/// and hovered through midstance: 83 of 121 walks over 1 mm, 1.5–6.1 mm (1.0–2.0 km/h every
+/// 0.1 × 1.5–2.0 m every 5 cm; 1 km/h heel up 1 mm at 5–8 % of the cycle). The projected lock with the rest length shortened by
+/// once the reach (as at 2 km/h) left 1.1–2.4 mm; twice the reach, ramped in over the first
+/// [`super::stance::REST_RAMP_IN`] = 10 % of the stance, keeps it down: ≤ 0.09 mm over 1.0–2.5
+/// km/h × 1.5–2.0 m every 5 cm except 1.4 km/h × 1.6 m (3.99 mm: its landing knee flexes
+/// 0.27 rad and the ankle meets its dorsiflexion limit at foot flat), the heel rising at 33–36 %
+/// of the cycle at 1 km/h (human 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
+/// 0.05 × 1.5–2.0 m every 5 cm, 341 steady walks and 176 from standing with a stop): 0 → 2 and
+/// 1 → 1 walks over 5 (1.05 km/h × 1.50 m 5.12, 1.10 × 1.55 m 5.08 steady and 5.09 from
+/// standing, l_knee; the stop's 1.8 km/h × 2.0 m 5.14 gone with `edge_lock`). Earlier
+/// attempts (session 9, before the heel rocker's `DIP_TRADE` = 3 and the last stance's lock)
+/// broke the last stance before a stop (10.06) and a first trailing leg (24.7).
+pub const SLOW_REST_REACH: f64 = 2.0;
+
+/// Froude speeds between which [`SLOW_REST_REACH`] blends to once the reach (see there).
+pub const SLOW_REST_FROUDE: [f64; 2] = [0.14, 0.20];
 
 /// Froude speed below which a stance that locks at the projected length
-/// ([`PROJECTED_LOCK_FROUDE_MIN`]) also shortens its leg spring's rest length by the same reach
+/// ([`PROJECTED_LOCK_FROUDE_MAX`]) also shortens its leg spring's rest length by the reach
+/// ([`SLOW_REST_REACH`] × it in the slowest walks)
 /// (`StanceSpec::rest_reach`, ramped in over the first 20 % of the stance and out from its
 /// middle: `stance::REST_RAMP_IN`/`REST_RAMP_OUT`).
 ///
@@ -348,7 +345,7 @@ pub const REST_SHORTENING_FROUDE_MAX: f64 = 0.24;
 /// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m);
 /// above it the drawn knee takes the same reach instead (`StanceSpec::flat_reach`, through
 /// `StanceSpec::drawn_span`: the midstance knee drawn with the 3-D leg's flexion), so the
-/// stance heel stays down at every speed from [`PROJECTED_LOCK_FROUDE_MIN`] on.
+/// stance heel stays down at every speed.
 ///
 /// Why not the lower lock above: its lower hip makes the arms jolt harder at heel strike
 /// (the shoulder's step at 7 km/h × 1.8 m, frame 287 before the lead-out: 0.0072 → 0.0107
@@ -358,11 +355,32 @@ pub const REST_SHORTENING_FROUDE_MAX: f64 = 0.24;
 pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
 
 /// Whether a stance at `speed` m/s of a body with unloaded leg `l1` locks at the sagittal
-/// projection of the drawn leg (see [`PROJECTED_LOCK_FROUDE_MIN`]): not on the first step from
-/// standing nor the last before a stop (`edge`), whose own rules keep their measured landings.
-fn projected_lock(speed: f64, l1: f64, edge: bool) -> bool {
+/// projection of the drawn leg (below [`PROJECTED_LOCK_FROUDE_MAX`]): not on the first step from
+/// standing (`from_rest`), nor on the last before a stop (`to_rest`) at or above
+/// [`REST_SHORTENING_FROUDE_MAX`], whose own rules keep their measured landings (see
+/// [`edge_lock`]).
+fn projected_lock(speed: f64, l1: f64, from_rest: bool, to_rest: bool) -> bool {
     let froude = super::stance::froude_speed(speed, l1);
-    !edge && (PROJECTED_LOCK_FROUDE_MIN..PROJECTED_LOCK_FROUDE_MAX).contains(&froude)
+    !from_rest && (!to_rest || edge_lock(froude)) && froude < PROJECTED_LOCK_FROUDE_MAX
+}
+
+/// Whether the last stance before a stop locks at the projected length (and shortens its rest
+/// length) like the walk's: in slow walks (Froude below [`REST_SHORTENING_FROUDE_MAX`]).
+///
+/// Why: a slow walk's stances all lower the hip ([`SLOW_REST_REACH`]); a last stance that kept
+/// the paper's lock landed its knee from the lower hip into a straight leg (1 km/h × 2.0 m from
+/// standing with a stop 5.67, r_knee; the stop's landing ankle at 1.8 km/h × 2.0 m 5.14 → 4.35).
+/// Faster, the last stance keeps the paper's lock: locking it raised 7 km/h × 1.5 m's stop
+/// 3.36 → 4.2.
+/// The rest length's shortening in units of the projected reach at Froude speed `froude`:
+/// [`SLOW_REST_REACH`] up to [`SLOW_REST_FROUDE`]`[0]`, 1 from [`SLOW_REST_FROUDE`]`[1]`.
+fn slow_rest_factor(froude: f64) -> f64 {
+    let [lo, hi] = SLOW_REST_FROUDE;
+    1.0 + (SLOW_REST_REACH - 1.0) * smoothstep(((hi - froude) / (hi - lo)).clamp(0.0, 1.0))
+}
+
+fn edge_lock(froude: f64) -> bool {
+    froude < REST_SHORTENING_FROUDE_MAX
 }
 
 fn side_z(side: Side, a: &WalkAttributes) -> f64 {
@@ -715,14 +733,18 @@ pub fn generate_steps(
         // Where the lock is not shortened by it, the drawn knee takes it (`drawn_span`); in
         // slow walks the spring's rest length is shortened by it as well
         // (`REST_SHORTENING_FROUDE_MAX`).
-        let projected = projected_lock(l.speed_m_per_s, body.l1, from_rest || to_rest);
-        let slow =
-            super::stance::froude_speed(l.speed_m_per_s, body.l1) < REST_SHORTENING_FROUDE_MAX;
+        let projected = projected_lock(l.speed_m_per_s, body.l1, from_rest, to_rest);
+        let froude = super::stance::froude_speed(l.speed_m_per_s, body.l1);
+        let slow = froude < REST_SHORTENING_FROUDE_MAX;
         let spec = StanceSpec {
             lock_short,
             lock_reach: if projected { flat_reach } else { 0.0 },
             flat_reach,
-            rest_reach: if projected && slow { flat_reach } else { 0.0 },
+            rest_reach: if projected && slow {
+                flat_reach * slow_rest_factor(froude)
+            } else {
+                0.0
+            },
             ..spec
         };
         let (st_solved, st_run) = spec

@@ -169,10 +169,14 @@ pub struct StanceSpec {
 }
 
 /// Fraction of the stance over which the leg spring's shortened rest length ramps in from
-/// heel strike ([`StanceSpec::rest_length`]). Measured against 0.1 (2 km/h, 8 steps): the heel
-/// ≤ 0.29 mm against 0.00 mm, but the knee a few frames after foot flat 2.9/2.8/2.7 against
-/// 3.5/2.9/2.8 at 1.5/1.8/2.0 m, and from standing at 1.5 m 2.9 against 3.6.
-pub const REST_RAMP_IN: f64 = 0.2;
+/// heel strike ([`StanceSpec::rest_length`]).
+///
+/// Why 0.1: the slowest walks (`generate::SLOW_REST_REACH`) need the hip lowered by foot flat,
+/// which comes 8–12 % into their stance; over 20 % the heel still rose 0.9–1.9 mm at 1.0–1.5
+/// km/h. Cost at 2 km/h (8 steps; 0.2 → 0.1): the heel ≤ 0.29 → 0.00 mm, but the knee a few
+/// frames after foot flat 2.9/2.8/2.7 → 3.5/2.9/2.8 at 1.5/1.8/2.0 m, and from standing at 1.5 m
+/// 2.9 → 3.6 (all within k = 5).
+pub const REST_RAMP_IN: f64 = 0.1;
 
 /// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by
 /// the end of the stance ([`StanceSpec::rest_length`]): the next heel strike meets the hip
@@ -276,7 +280,7 @@ impl StanceSpec {
     /// (flat only up to `l − 2σ`) the flat foot rolled onto its ball: the heel hovered ≈ 5 mm
     /// up from foot flat to heel off. The rigid leg here is the sagittal projection of the 3-D
     /// leg with that soft knee (`lock_reach`, set by the generator from the stance's largest
-    /// `dz`, at Froude speeds 0.16–0.65: `generate::PROJECTED_LOCK_FROUDE_MIN`; below 0.24 with
+    /// `dz`, at Froude speeds below 0.65: `generate::PROJECTED_LOCK_FROUDE_MAX`; below 0.24 with
     /// the spring's rest length shortened too, [`StanceSpec::rest_length`]), so the stance
     /// heel stays down until the extension lifts it. Above that speed the drawn knee takes the
     /// same reach instead ([`StanceSpec::drawn_span`]).
