@@ -82,7 +82,9 @@ pub const SL_LONG: f64 = 0.95;
 /// The attributes (§3.1.2, Fig. 5).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Attr {
-    /// Arm swing factor: shoulder flexion = factor × the opposite leg's hip angle (§3.3.3).
+    /// Arm swing factor: shoulder flexion = factor × the opposite leg's arm drive, between its
+    /// hip–ankle angle at its toe off and its swing hip flexion (§3.3.3;
+    /// `upper_body::arm_driver`).
     ArmSwing,
     /// Minimum elbow flexion (backward swing at toe off).
     ElbowMin,
@@ -160,7 +162,7 @@ pub const SW_REF: f64 = 0.08;
 /// The attribute table. Values are for a 1.8 m figure; see the module docs for scaling.
 pub const SPECS: [AttrSpec; 19] = [
     AttrSpec { attr: Attr::ArmSwing, name: "arm_swing", unit: AttrUnit::Factor, min: 0.0, max: 3.0, default: 1.0, couplings: &[],
-        doc: "shoulder flexion = factor × opposite hip angle (forward) / hip–ankle angle (backward)" },
+        doc: "shoulder flexion = factor × the opposite leg's swing: back to its hip–ankle angle at its toe off, forward to its swing hip flexion" },
     AttrSpec { attr: Attr::ElbowMin, name: "elbow_min", unit: AttrUnit::Degrees, min: 0.0, max: 150.0 * D, default: 65.0 * D, couplings: &[],
         doc: "elbow flexion at the back of the arm swing (toe off of the same-side leg's opposite)" },
     AttrSpec { attr: Attr::ElbowMax, name: "elbow_max", unit: AttrUnit::Degrees, min: 0.0, max: 150.0 * D, default: 100.0 * D, couplings: &[],

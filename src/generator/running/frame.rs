@@ -9,7 +9,7 @@ use super::dims::{
 };
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
 use super::state::{StepKind, StepPlan};
-use super::upper_body::{arm_beta, arm_driver, fill_upper};
+use super::upper_body::{arm_drivers, fill_upper};
 use crate::generator::skeleton::{Joint, Pose};
 
 /// Per-frame facts besides the pose.
@@ -113,10 +113,7 @@ pub fn eval_frame(plan: &StepPlan, d: &RunnerDims, t: f64, pose: &mut Pose) -> F
         pose.rotations[mtp.index()] = DQuat::from_rotation_z(ang.meta);
     }
 
-    let mut drivers = [0.0; 2];
-    drivers[idx(s)] = arm_driver(&st_ang, &st_pts, arm_beta(plan, t, true));
-    drivers[idx(-s)] = arm_driver(&sw_ang, &sw_pts, arm_beta(plan, t, false));
-    fill_upper(plan, t, yaw, roll, drivers, pose);
+    fill_upper(plan, t, yaw, roll, arm_drivers(plan, t), pose);
 
     let mut info = FrameInfo {
         contact: [false; 2],

@@ -153,6 +153,11 @@ pub struct Carry {
     pub arm_back: f64,
     /// Maximum swing hip flexion (the front end of the arm swing), rad.
     pub arm_front: f64,
+    /// Arm-drive phase of the landed leg (rad in [0, 2π): 0 at its toe off, π at the other
+    /// leg's; see [`StepPlan::arm_phase`]).
+    pub arm_phase: f64,
+    /// Rate of the arm-drive phase, rad/s.
+    pub arm_phase_rate: f64,
 }
 
 /// Inputs of one step: the parameters and effective attributes in force.
@@ -296,6 +301,12 @@ pub struct StepPlan {
     pub arm_back: (f64, f64),
     /// Arm-swing front end at the start of the step and for this step, rad.
     pub arm_front: (f64, f64),
+    /// Arm-drive phase keys (t, phase, rate) of the stance leg, joined by cubic Hermite
+    /// segments: the phase is 0 (mod 2π) at the leg's toe off, where the arm it drives is at
+    /// the back of its swing, and π at the other leg's toe off (the front); the swing leg's
+    /// phase is π ahead. A running step keys its heel strike (carried), its toe off (2π) and
+    /// its end (heading for the next toe off at the step's own rate, π per toe off to toe off).
+    pub arm_phase: [(f64, f64, f64); 3],
     /// Speed, m/s.
     pub speed: f64,
     /// Step length, m.
@@ -525,6 +536,10 @@ pub fn standing_carry(
         ],
         arm_back: 0.0,
         arm_front: 0.0,
+        // At rest; the first step's stance leg swings its arm from the front (π) to the back
+        // at its toe off (2π), from a standstill of the phase.
+        arm_phase: std::f64::consts::PI,
+        arm_phase_rate: 0.0,
     }
 }
 
@@ -861,6 +876,16 @@ pub fn plan_step(
         ],
         arm_back: (carry.arm_back, carry.arm_back),
         arm_front: (carry.arm_front, e.swing_hip),
+        arm_phase: {
+            // From the carried heel-strike phase to the toe off (2π) C1, then on at π per toe
+            // off to toe off (this step's flight + support, the next step's assumed alike).
+            let rate = std::f64::consts::PI / (t_flight + t_stance);
+            [
+                (0.0, carry.arm_phase, carry.arm_phase_rate),
+                (t_stance, std::f64::consts::TAU, rate),
+                (t_step, std::f64::consts::TAU + rate * t_flight, rate),
+            ]
+        },
         speed: v,
         step_length: sl,
         step_freq: sf,
@@ -1382,6 +1407,9 @@ pub fn carry_out(plan: &StepPlan, d: &RunnerDims) -> Carry {
         upper: upper_attrs(&plan.eff),
         arm_back: plan.arm_back.1,
         arm_front: plan.arm_front.1,
+        // The landing leg is π behind the leg that took off.
+        arm_phase: (plan.arm_phase[2].1 - std::f64::consts::PI).rem_euclid(std::f64::consts::TAU),
+        arm_phase_rate: plan.arm_phase[2].2,
     }
 }
 
@@ -1498,6 +1526,15 @@ pub fn plan_stop(d: &RunnerDims, carry: &Carry, eff: &Effective) -> StepPlan {
         ],
         arm_back: (carry.arm_back, carry.arm_back),
         arm_front: (carry.arm_front, carry.arm_front),
+        // The arms keep their rhythm while they fade out (`upper_body::fill_upper`).
+        arm_phase: {
+            let end = carry.arm_phase + carry.arm_phase_rate * t_stop;
+            [
+                (0.0, carry.arm_phase, carry.arm_phase_rate),
+                (t_stop, end, carry.arm_phase_rate),
+                (t_stop, end, carry.arm_phase_rate),
+            ]
+        },
         speed: 0.0,
         step_length: 0.0,
         step_freq: 0.0,
