@@ -315,13 +315,18 @@ fn num_err(stage: String, message: String) -> GenerateError {
 /// and hovered through midstance: 83 of 121 walks over 1 mm, 1.5–6.1 mm (1.0–2.0 km/h every
 /// 0.1 × 1.5–2.0 m every 5 cm; 1 km/h heel up 1 mm at 5–8 % of the cycle). The projected lock with the rest length shortened by
 /// once the reach (as at 2 km/h) left 1.1–2.4 mm; twice the reach, ramped in over the first
-/// [`super::stance::REST_RAMP_IN`] = 10 % of the stance, keeps it down: ≤ 0.09 mm over 1.0–2.5
+/// [`super::stance::REST_RAMP_IN_SLOW`] = 10 % of the stance, keeps it down: ≤ 0.09 mm over 1.0–2.5
 /// km/h × 1.5–2.0 m every 5 cm except 1.4 km/h × 1.6 m (3.99 mm: its landing knee flexes
 /// 0.27 rad and the ankle meets its dorsiflexion limit at foot flat), the heel rising at 33–36 %
 /// of the cycle at 1 km/h (human 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
-/// 0.05 × 1.5–2.0 m every 5 cm, 341 steady walks and 176 from standing with a stop): 0 → 2 and
-/// 1 → 1 walks over 5 (1.05 km/h × 1.50 m 5.12, 1.10 × 1.55 m 5.08 steady and 5.09 from
-/// standing, l_knee; the stop's 1.8 km/h × 2.0 m 5.14 gone with `edge_lock`). Earlier
+/// 0.05 × 1.5–2.0 m every 5 cm, 341 steady walks and 176 from standing with a stop): alone,
+/// 0 → 2 and 1 → 1 walks over 5 (1.05 km/h × 1.50 m 5.12, 1.10 × 1.55 m 5.08 steady and 5.09
+/// from standing, l_knee: the trailing knee, see `hold_knees`; the stop's 1.8 km/h × 2.0 m 5.14
+/// gone with `edge_lock`), 40 steady walks over 4.5 (1 before); with `hold_knees`' relaxed
+/// floor none over 5 (worst 4.27 and 4.69). The midstance knee is more flexed: 1 km/h ×
+/// 1.5/1.8/2.0 m 7.5/2.8/1.2° → 10.6/9.1/8.1° (as at 2–3 km/h, 9–12°). The default events'
+/// double support at 1.5 km/h × 1.6 m comes out +32.3 ms long (+12.8 before; the limit there
+/// is 10 % = 36.6 ms: the lower hip through the double support). Earlier
 /// attempts (session 9, before the heel rocker's `DIP_TRADE` = 3 and the last stance's lock)
 /// broke the last stance before a stop (10.06) and a first trailing leg (24.7).
 pub const SLOW_REST_REACH: f64 = 2.0;
@@ -713,6 +718,7 @@ pub fn generate_steps(
             lock_reach: 0.0,
             flat_reach: 0.0,
             rest_reach: 0.0,
+            rest_ramp_in: super::stance::REST_RAMP_IN,
         };
         // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
         let lock_short = super::stance::lock_shortening(spec.push_off);
@@ -745,6 +751,10 @@ pub fn generate_steps(
             } else {
                 0.0
             },
+            rest_ramp_in: super::stance::REST_RAMP_IN
+                + (super::stance::REST_RAMP_IN_SLOW - super::stance::REST_RAMP_IN)
+                    * (slow_rest_factor(froude) - 1.0)
+                    / (SLOW_REST_REACH - 1.0),
             ..spec
         };
         let (st_solved, st_run) = spec
@@ -1239,8 +1249,17 @@ fn smooth_rolls(data: &mut [StepData]) {
 /// on (about the ball or the toe tip, so nothing slides or sinks) until the knee is as flexed
 /// as it was. A leg's late stance is recorded in two steps (its own stance, then the next
 /// step's double support), so the two are joined. The toe-off samples (the last two, where the
-/// swing takes over with their state) are kept; if the hold would need them, the leg is left
-/// as it was.
+/// swing takes over with their state) keep their roll. Where the hold would need them — the
+/// knee ends its late stance straighter than its peak: slow walks, whose trailing knee stays
+/// near the heel-off rule's soft floor to toe off, with bumps of ≈ 0.01 rad where the hip comes
+/// closer — the floor descends linearly from the peak to the toe-off knee instead (≈ 0.03 rad/s
+/// at 1.1 km/h); only if that fails too is the leg left as it was.
+///
+/// Why the descent: giving the hold up left the bump, straightened in 3 frames after the other
+/// foot's foot flat (1.1 km/h × 1.7 m 4.87, 1.05 km/h × 1.5 m 5.12, r/l_knee, once the slowest
+/// stances lowered the hip, [`SLOW_REST_REACH`]). With it, 1.0–2.5 km/h every 0.05 × 1.5–2.0 m
+/// every 5 cm (341 steady walks): worst 5.12 → 4.27, geometric mean 3.31 → 3.05, walks over
+/// 4.5: 40 → 0; from standing with a stop (176): 5.09 → 4.69; 2.5–7 km/h unchanged.
 ///
 /// Why: the heel-off rule's roll accelerates through late stance with the push-off and
 /// flattens at heel strike, where the push-off ends; the least-bending roll above the rule
@@ -1364,29 +1383,59 @@ fn hold_knees(data: &mut [StepData]) {
                     }
             })
             .collect();
-        let mut floor: Vec<f64> = knees[i0..]
+        let prefix_max: Vec<f64> = knees[i0..]
             .iter()
             .scan(f64::NEG_INFINITY, |m, &k| {
                 *m = k.max(*m);
                 Some(*m)
             })
             .collect();
-        smooth_roll(&times, &mut floor, 0, false, KNEE_HOLD_TAU);
-        let mut held = vec![sample(data, &chain[0]).3];
-        let mut ok = true;
-        for (j, s) in chain.iter().enumerate().skip(1) {
-            let (leg, hip, dz, r) = sample(data, s);
-            let r = r.max(held[j - 1]);
-            if leg.pose_at(hip, dz, r).knee < floor[j] - 1e-9 {
-                if j + 2 >= chain.len() {
-                    ok = false;
-                    break;
+        let hold = |floor: &mut Vec<f64>| -> Option<Vec<f64>> {
+            smooth_roll(&times, floor, 0, false, KNEE_HOLD_TAU);
+            let mut held = vec![sample(data, &chain[0]).3];
+            for (j, s) in chain.iter().enumerate().skip(1) {
+                let (leg, hip, dz, r) = sample(data, s);
+                let r0 = r;
+                let r = r.max(held[j - 1]);
+                if leg.pose_at(hip, dz, r).knee < floor[j] - 1e-9 {
+                    if j + 2 >= chain.len() {
+                        return None;
+                    }
+                    held.push(leg.roll_for_knee(hip, dz, r, floor[j]));
+                } else if j + 2 >= chain.len() && r > r0 + 1e-9 {
+                    // The toe-off samples keep their roll (the swing starts from it).
+                    return None;
+                } else {
+                    held.push(r);
                 }
-                held.push(leg.roll_for_knee(hip, dz, r, floor[j]));
-            } else {
-                held.push(r);
             }
-        }
+            Some(held)
+        };
+        // Where the knee ends its late stance straighter than it has been (slow walks, whose
+        // trailing knee stays near the heel-off rule's soft floor to toe off), a floor that
+        // never decreases would need the toe-off samples: the floor then descends linearly
+        // from the peak to the toe-off knee.
+        let mut floor = prefix_max.clone();
+        let held = hold(&mut floor).or_else(|| {
+            let n = prefix_max.len();
+            let (t_end, k_end) = (times[n - 2], knees[i0 + n - 2]);
+            let peak = (0..n).find(|&j| prefix_max[j] >= prefix_max[n - 1])?;
+            let (t_peak, k_peak) = (times[peak], prefix_max[n - 1]);
+            if t_end <= t_peak + 1e-9 {
+                return None;
+            }
+            let mut floor: Vec<f64> = (0..n)
+                .map(|j| {
+                    let line = k_peak
+                        + (k_end - k_peak)
+                            * ((times[j] - t_peak) / (t_end - t_peak)).clamp(0.0, 1.0);
+                    prefix_max[j].min(line.max(k_end))
+                })
+                .collect();
+            hold(&mut floor)
+        });
+        let ok = held.is_some();
+        let held = held.unwrap_or_default();
         if !ok {
             continue;
         }

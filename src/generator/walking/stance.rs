@@ -166,17 +166,26 @@ pub struct StanceSpec {
     /// How much shorter than `l1` the leg spring's rest length is through the stance's first
     /// half, m (0: the paper's rest length `l1`; see [`StanceSpec::rest_length`]).
     pub rest_reach: f64,
+    /// Fraction of the stance over which the shortened rest length ramps in from heel strike
+    /// ([`StanceSpec::rest_length`]; [`REST_RAMP_IN`], less in the slowest walks:
+    /// `generate::SLOW_REST_REACH`).
+    pub rest_ramp_in: f64,
 }
 
 /// Fraction of the stance over which the leg spring's shortened rest length ramps in from
-/// heel strike ([`StanceSpec::rest_length`]).
+/// heel strike ([`StanceSpec::rest_length`]) at 2 km/h and up; the slowest walks ramp it in over
+/// [`REST_RAMP_IN_SLOW`]. Measured against 0.1 (2 km/h, 8 steps): the heel ≤ 0.29 mm against
+/// 0.00 mm, but the knee a few frames after foot flat 2.9/2.8/2.7 against 3.5/2.9/2.8 at
+/// 1.5/1.8/2.0 m, and from standing at 1.5 m 2.9 against 3.6.
+pub const REST_RAMP_IN: f64 = 0.2;
+
+/// [`REST_RAMP_IN`] of the slowest walks (`generate::SLOW_REST_REACH`, blended over the same
+/// Froude speeds).
 ///
-/// Why 0.1: the slowest walks (`generate::SLOW_REST_REACH`) need the hip lowered by foot flat,
-/// which comes 8–12 % into their stance; over 20 % the heel still rose 0.9–1.9 mm at 1.0–1.5
-/// km/h. Cost at 2 km/h (8 steps; 0.2 → 0.1): the heel ≤ 0.29 → 0.00 mm, but the knee a few
-/// frames after foot flat 2.9/2.8/2.7 → 3.5/2.9/2.8 at 1.5/1.8/2.0 m, and from standing at 1.5 m
-/// 2.9 → 3.6 (all within k = 5).
-pub const REST_RAMP_IN: f64 = 0.1;
+/// Why: their hip must be down by foot flat, 8–12 % into the stance; over 20 % the heel still
+/// rose 0.9–1.9 mm at 1.0–1.5 km/h. Why not at every speed: over 10 % at 2.5–3 km/h (Froude
+/// 0.20–0.24) the worst continuity ratio rose by up to 1.5 (2.6 km/h × 2.0 m 2.92 → 4.40).
+pub const REST_RAMP_IN_SLOW: f64 = 0.1;
 
 /// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by
 /// the end of the stance ([`StanceSpec::rest_length`]): the next heel strike meets the hip
@@ -351,7 +360,7 @@ impl StanceSpec {
     /// 2 km/h. Only a shorter rest length lowers the hip there (klawflat3, session 7).
     pub fn rest_length(&self, t: f64) -> f64 {
         let d = self.duration.max(1e-9);
-        let on = smoothstep((t / (REST_RAMP_IN * d)).clamp(0.0, 1.0));
+        let on = smoothstep((t / (self.rest_ramp_in.max(1e-3) * d)).clamp(0.0, 1.0));
         let off = smoothstep(((t / d - REST_RAMP_OUT) / (1.0 - REST_RAMP_OUT)).clamp(0.0, 1.0));
         self.l1 - self.rest_reach.max(0.0) * on * (1.0 - off)
     }
@@ -645,6 +654,7 @@ mod tests {
             lock_reach: 0.0,
             flat_reach: 0.0,
             rest_reach: 0.0,
+            rest_ramp_in: REST_RAMP_IN,
         };
         let start = StanceStart {
             q: [
