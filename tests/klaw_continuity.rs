@@ -779,31 +779,18 @@ fn slow_walks_between_the_grid_points_meet_k5() {
             }
         }
     }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let failures = std::sync::Mutex::new(Vec::new());
-    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(kmh, h, rest)) = cases.get(i) else {
-                    break;
-                };
-                let steps = if rest { 6 } else { 8 };
-                let (w, report) = worst(&[(kmh, steps)], h, rest);
-                let bound = KNOWN
-                    .iter()
-                    .find(|k| (k.0 - kmh).abs() < 1e-6 && (k.1 - h).abs() < 1e-6 && k.2 == rest)
-                    .map_or(ContinuityOptions::default().k, |k| 1.05 * k.3);
-                if w > bound {
-                    failures.lock().unwrap().push(format!(
-                        "{kmh:.2} km/h x {h:.2} m, from standing {rest}: {report}"
-                    ));
-                }
-            });
-        }
-    });
-    let failures = failures.into_inner().unwrap();
+    let failures: Vec<String> = common::par_map(&cases, |&(kmh, h, rest)| {
+        let steps = if rest { 6 } else { 8 };
+        let (w, report) = worst(&[(kmh, steps)], h, rest);
+        let bound = KNOWN
+            .iter()
+            .find(|k| (k.0 - kmh).abs() < 1e-6 && (k.1 - h).abs() < 1e-6 && k.2 == rest)
+            .map_or(ContinuityOptions::default().k, |k| 1.05 * k.3);
+        (w > bound).then(|| format!("{kmh:.2} km/h x {h:.2} m, from standing {rest}: {report}"))
+    })
+    .into_iter()
+    .flatten()
+    .collect();
     assert!(
         failures.is_empty(),
         "{} of {} walks: {failures:#?}",

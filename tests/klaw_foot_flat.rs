@@ -120,31 +120,22 @@ fn the_slow_stance_heel_stays_down_between_the_grid_points() {
     let cases: Vec<(f64, f64)> = (0..=10)
         .flat_map(|i| (0..=10).map(move |j| (1.0 + 0.1 * f64::from(i), 1.5 + 0.05 * f64::from(j))))
         .collect();
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let failures = std::sync::Mutex::new(Vec::new());
-    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| loop {
-                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(&(kmh, h)) = cases.get(i) else {
-                    break;
-                };
-                let (worst, _, n, _) = heel_hover(kmh, h);
-                let bound = KNOWN
-                    .iter()
-                    .find(|k| (k.0 - kmh).abs() < 1e-6 && (k.1 - h).abs() < 1e-6)
-                    .map_or(1e-3, |k| 1.05 * k.2);
-                if n < 6 || worst > bound {
-                    failures.lock().unwrap().push(format!(
-                        "{kmh:.1} km/h × {h:.2} m: heel {:.2} mm, {n} stances",
-                        1e3 * worst
-                    ));
-                }
-            });
-        }
-    });
-    let failures = failures.into_inner().unwrap();
+    let failures: Vec<String> = common::par_map(&cases, |&(kmh, h)| {
+        let (worst, _, n, _) = heel_hover(kmh, h);
+        let bound = KNOWN
+            .iter()
+            .find(|k| (k.0 - kmh).abs() < 1e-6 && (k.1 - h).abs() < 1e-6)
+            .map_or(1e-3, |k| 1.05 * k.2);
+        (n < 6 || worst > bound).then(|| {
+            format!(
+                "{kmh:.1} km/h × {h:.2} m: heel {:.2} mm, {n} stances",
+                1e3 * worst
+            )
+        })
+    })
+    .into_iter()
+    .flatten()
+    .collect();
     assert!(
         failures.is_empty(),
         "{} of {} walks: {failures:#?}",

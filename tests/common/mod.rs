@@ -134,3 +134,26 @@ pub fn next_event(m: &Motion, kind: EventKind, side: Side, after_s: f64) -> Opti
         .iter()
         .find(|e| e.kind == kind && e.side == side && e.time_s > after_s)
 }
+
+/// `f` over `cases` on every available core (walk grids of hundreds of walks), the results in
+/// the order of `cases`.
+pub fn par_map<T: Sync, R: Send>(cases: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let out = std::sync::Mutex::new(Vec::with_capacity(cases.len()));
+    let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(case) = cases.get(i) else {
+                    break;
+                };
+                let r = f(case);
+                out.lock().unwrap().push((i, r));
+            });
+        }
+    });
+    let mut out = out.into_inner().unwrap();
+    out.sort_by_key(|p| p.0);
+    out.into_iter().map(|p| p.1).collect()
+}
