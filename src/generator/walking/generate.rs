@@ -706,11 +706,14 @@ pub fn generate_steps(
             monitor_gain: 20.0,
             target: [hs.w, hs.theta1],
             max_step: a.max_step_s,
-            // No push-off on the first step from standing (it starts at rest, far slower than
-            // its speed) nor on the last before the stop (the body is brought to rest): with it
-            // there, 7 km/h × 1.5 m measured start 12.0 → 14.8, stop 3.6 → 4.9.
-            push_off: if from_rest || to_rest {
+            // No push-off on the last step before the stop (the body is brought to rest): with
+            // it there, 7 km/h × 1.5 m measured stop 3.6 → 4.9. The first step from standing
+            // pushes off late (`stance::first_push_off_exponent`, klawstart4), so the hip does
+            // not fall onto the next heel.
+            push_off: if to_rest {
                 2.0
+            } else if from_rest {
+                super::stance::first_push_off_exponent(l.speed_m_per_s, body.l1)
             } else {
                 super::stance::push_off_exponent(l.speed_m_per_s, body.l1)
             },

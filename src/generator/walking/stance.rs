@@ -222,6 +222,48 @@ pub fn push_off_exponent(speed: f64, l1: f64) -> f64 {
     (2.0 + (froude - PUSH_OFF_FROUDE_0) / PUSH_OFF_FROUDE_STEP).clamp(2.0, PUSH_OFF_MAX)
 }
 
+/// Froude speed over which the first stance from standing's push-off exponent rises from 2 to
+/// [`PUSH_OFF_MAX`], from [`PUSH_OFF_FROUDE_0`] (see [`first_push_off_exponent`]).
+pub const FIRST_PUSH_OFF_FROUDE_RAMP: f64 = 0.05;
+
+/// The extension profile's exponent `n` ([`StanceSpec::push_off`]) of the first stance from
+/// standing for a walk at `speed` m/s with an unloaded leg `l1` m long: 2 (the paper's
+/// quadratic extension) up to [`PUSH_OFF_FROUDE_0`], where the walk's own push-off starts, then
+/// rising (smoothstep in Froude speed) to [`PUSH_OFF_MAX`] over
+/// [`FIRST_PUSH_OFF_FROUDE_RAMP`] — ≈ 3.0 → 3.5 km/h for a 1.8 m body, 2.75 → 3.2 km/h for
+/// 1.5 m. A change to the paper (klawstart4), which gives no profile for `pa`.
+///
+/// Why: the first stance starts at rest on a vertical leg, so its whole stance is the extension,
+/// and the quadratic profile spread the leg's lengthening (from the standing length to eq. 3's
+/// at heel strike) over the step: the leg reached heel strike lengthening at only 0.11 m/s
+/// while it swept forward, and the hip fell onto the next heel at −0.43 m/s (4 km/h × 1.5 m;
+/// −0.21 m/s at the walk's later heel strikes, which push off). The landing leg's flat foot
+/// was then within reach 31 ms after heel strike and its knee rose as √ (0.38 rad at its
+/// peak), so the planned heel rocker (`VirtualLeg::plan_heel_rocker`) could only start the
+/// knee, straight and at rest in swing3, at 3 × its mean rate: 0.126 rad in the first frame
+/// (continuity 5.17 at 4 km/h × 1.5 m, 5.37 at 1.55 m, frame 57–58, r_knee). A late profile puts
+/// the extension where a person starting to walk pushes off with the first stance leg, just
+/// before the other heel lands: at `n` = 6 the leg lengthens at 0.26 m/s at heel strike and the
+/// hip falls at −0.30 m/s, and the rocker's knee starts at 2.5 × its mean rate (4 km/h × 1.5 m
+/// 5.17 → 4.40, 1.55 m 5.37 → 4.59). The walk's own exponent (3.1 there) is not enough (3.0:
+/// 5.24/5.44); a constant exponent of 3.5–5.5 for every speed put 3.5 km/h × 1.5 m (8 steps)
+/// at 5.09–5.26 (its heel rocker switched landings), only 6 kept it down (3.79 → 4.34), and 6
+/// at 3 km/h × 1.8 m made its start worse (3.30 → 3.61): below [`PUSH_OFF_FROUDE_0`] the first
+/// stance keeps the paper's profile, as the walk does. Measured (from standing with a stop,
+/// continuity k = 5): the 243-walk regression sweep 12 → 11 over 5, one walk worse (4 km/h ×
+/// 2.0 m 3.55 → 3.81, frame 66 r_knee), 7 km/h × 1.5 m 5.62 → 5.56 (the push-off here once
+/// measured 12.0 → 14.8 there, on an earlier state of the walk); 2.8–4.2 km/h every
+/// 0.05 × 1.5–1.7 m every 5 cm (6 steps, 145 walks) 4 → 1 over 5 (the one left, 3.3 km/h ×
+/// 1.55 m, is a later stance's knee, unchanged), mean change −0.12, the largest rise 3.5 km/h ×
+/// 1.55 m 3.21 → 4.24; 1–7 km/h every 0.25 × 1.5–2.0 m every 10 cm (8 steps, 150 walks) 4 → 3
+/// over 5, the largest rise 3.5 km/h × 1.6 m 3.28 → 4.21. Ramps of 0.03 and 0.07 measured the
+/// same (sweep identical, 1 of the 145 over 5).
+pub fn first_push_off_exponent(speed: f64, l1: f64) -> f64 {
+    let froude = froude_speed(speed, l1);
+    let u = ((froude - PUSH_OFF_FROUDE_0) / FIRST_PUSH_OFF_FROUDE_RAMP).clamp(0.0, 1.0);
+    2.0 + (PUSH_OFF_MAX - 2.0) * smoothstep(u)
+}
+
 /// Midstance shortening of the locked leg per unit of push-off exponent above 2, fraction of
 /// `l1` (see [`lock_shortening`]).
 pub const LOCK_SHORT_PER_PUSH: f64 = 0.006;
@@ -665,6 +707,27 @@ mod tests {
             qd: [-0.09291990504440535, 0.44645356106147843, 0.0],
         };
         (spec, start)
+    }
+
+    /// The first stance's push-off (`first_push_off_exponent`): the paper's quadratic up to the
+    /// walk's push-off speed, the latest profile a Froude ramp above it, continuous and rising.
+    #[test]
+    fn the_first_push_off_ramps_from_the_papers_profile_to_the_latest() {
+        let l1 = 0.87;
+        let speed = |froude: f64| froude * (crate::units::G * l1).sqrt();
+        for froude in [0.0, 0.1, PUSH_OFF_FROUDE_0] {
+            assert_eq!(first_push_off_exponent(speed(froude), l1), 2.0);
+        }
+        for froude in [PUSH_OFF_FROUDE_0 + FIRST_PUSH_OFF_FROUDE_RAMP, 0.5, 1.0] {
+            assert_eq!(first_push_off_exponent(speed(froude), l1), PUSH_OFF_MAX);
+        }
+        let mut last = 2.0;
+        for i in 0..=100 {
+            let froude = PUSH_OFF_FROUDE_0 + FIRST_PUSH_OFF_FROUDE_RAMP * i as f64 / 100.0;
+            let n = first_push_off_exponent(speed(froude), l1);
+            assert!(n >= last && n - last < 0.07, "{froude}: {last} -> {n}");
+            last = n;
+        }
     }
 
     #[test]
