@@ -313,12 +313,14 @@ fn num_err(stage: String, message: String) -> GenerateError {
 /// turns within a millimetre of it, so the stance locked at the paper's straight leg and the
 /// drawn 3-D leg could not reach its flat foot: the stance heel rose at once after foot flat
 /// and hovered through midstance: 83 of 121 walks over 1 mm, 1.5–6.1 mm (1.0–2.0 km/h every
-/// 0.1 × 1.5–2.0 m every 5 cm; 1 km/h heel up 1 mm at 5–8 % of the cycle). The projected lock with the rest length shortened by
-/// once the reach (as at 2 km/h) left 1.1–2.4 mm; twice the reach, ramped in over the first
-/// [`super::stance::REST_RAMP_IN_SLOW`] = 10 % of the stance, keeps it down: ≤ 0.09 mm over 1.0–2.5
-/// km/h × 1.5–2.0 m every 5 cm except 1.4 km/h × 1.6 m (3.99 mm: its landing knee flexes
-/// 0.27 rad and the ankle meets its dorsiflexion limit at foot flat), the heel rising at 33–36 %
-/// of the cycle at 1 km/h (human 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
+/// 0.1 × 1.5–2.0 m every 5 cm; 1 km/h heel up 1 mm at 5–8 % of the cycle). The projected lock
+/// with the rest length shortened by once the reach (as at 2 km/h) left 1.1–2.4 mm; twice the
+/// reach, ramped in over the first [`super::stance::REST_RAMP_IN_SLOW`] = 10 % of the stance,
+/// keeps it down: ≤ 0.09 mm over 1.0–2.5 km/h × 1.5–2.0 m every 5 cm except 1.4 km/h × 1.6 m
+/// (3.98 mm: its rocker landing, chosen by the slow-start rule of
+/// `VirtualLeg::plan_heel_rocker` at a threshold, reaches foot flat with the knee still
+/// flexing at 4.9 rad/s, and the ankle meets its dorsiflexion limit there), the heel rising at
+/// 33–36 % of the cycle at 1 km/h (human 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
 /// 0.05 × 1.5–2.0 m every 5 cm, 341 steady walks and 176 from standing with a stop): alone,
 /// 0 → 2 and 1 → 1 walks over 5 (1.05 km/h × 1.50 m 5.12, 1.10 × 1.55 m 5.08 steady and 5.09
 /// from standing, l_knee: the trailing knee, see `hold_knees`; the stop's 1.8 km/h × 2.0 m 5.14
@@ -369,14 +371,6 @@ fn projected_lock(speed: f64, l1: f64, from_rest: bool, to_rest: bool) -> bool {
     !from_rest && (!to_rest || edge_lock(froude)) && froude < PROJECTED_LOCK_FROUDE_MAX
 }
 
-/// Whether the last stance before a stop locks at the projected length (and shortens its rest
-/// length) like the walk's: in slow walks (Froude below [`REST_SHORTENING_FROUDE_MAX`]).
-///
-/// Why: a slow walk's stances all lower the hip ([`SLOW_REST_REACH`]); a last stance that kept
-/// the paper's lock landed its knee from the lower hip into a straight leg (1 km/h × 2.0 m from
-/// standing with a stop 5.67, r_knee; the stop's landing ankle at 1.8 km/h × 2.0 m 5.14 → 4.35).
-/// Faster, the last stance keeps the paper's lock: locking it raised 7 km/h × 1.5 m's stop
-/// 3.36 → 4.2.
 /// The rest length's shortening in units of the projected reach at Froude speed `froude`:
 /// [`SLOW_REST_REACH`] up to [`SLOW_REST_FROUDE`]`[0]`, 1 from [`SLOW_REST_FROUDE`]`[1]`.
 fn slow_rest_factor(froude: f64) -> f64 {
@@ -384,6 +378,15 @@ fn slow_rest_factor(froude: f64) -> f64 {
     1.0 + (SLOW_REST_REACH - 1.0) * smoothstep(((hi - froude) / (hi - lo)).clamp(0.0, 1.0))
 }
 
+/// Whether the last stance before a stop locks at the projected length (and shortens its rest
+/// length) like the walk's: in slow walks (Froude below [`REST_SHORTENING_FROUDE_MAX`]).
+///
+/// Why: a slow walk's stances all lower the hip ([`SLOW_REST_REACH`]); a last stance that kept
+/// the paper's lock landed its knee from the lower hip into a straight leg (1 km/h × 2.0 m from
+/// standing with a stop 5.67, r_knee; the stop's landing ankle at 1.8 km/h × 2.0 m 5.14 → 4.35,
+/// 3.27 since `hold_knees` relaxes its floor).
+/// Faster, the last stance keeps the paper's lock: locking it raised 7 km/h × 1.5 m's stop
+/// 3.36 → 4.2.
 fn edge_lock(froude: f64) -> bool {
     froude < REST_SHORTENING_FROUDE_MAX
 }
