@@ -157,3 +157,15 @@ pub fn par_map<T: Sync, R: Send>(cases: &[T], f: impl Fn(&T) -> R + Sync) -> Vec
     out.sort_by_key(|p| p.0);
     out.into_iter().map(|p| p.1).collect()
 }
+
+/// Runs `check` over the walk grid `cases` ([`par_map`]) and fails with every message it
+/// returned (`None`: the case passed), and how many of how many cases failed.
+pub fn assert_grid<T: Sync>(cases: &[T], check: impl Fn(&T) -> Option<String> + Sync) {
+    let failures: Vec<String> = par_map(cases, check).into_iter().flatten().collect();
+    assert!(
+        failures.is_empty(),
+        "{} of {} walks: {failures:#?}",
+        failures.len(),
+        cases.len()
+    );
+}
