@@ -109,14 +109,16 @@ fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
 /// Between the grid points of the slow walks (1.0–2.0 km/h every 0.1 × 1.5–2.0 m every 5 cm,
 /// 121 steady walks of 8 steps) the stance heel stays within 1 mm of the floor from foot flat to
 /// heel off / midstance. Measured on main 9c72f4f (before `generate::SLOW_REST_REACH`): 83 of the
-/// 121 walks hovered 1.5–6.1 mm (1.0–1.8 km/h; 1.5 km/h × 1.5 m 5.78 mm); now one, listed in
-/// `KNOWN` with its bound (its landing knee flexes 0.27 rad and the ankle meets its
-/// dorsiflexion limit at foot flat: heel off 1 frame after foot flat).
+/// 121 walks hovered 1.5–6.1 mm (1.0–1.8 km/h; 1.5 km/h × 1.5 m 5.78 mm); then one (1.4 km/h ×
+/// 1.6 m, 3.98 mm: heel off at foot flat, the knee ease flexing past the flat foot's knee) until
+/// the eased knee was bounded by the flat foot's (`virtual_leg::KNEE_ROCKER_EASE`): its heel now
+/// stays down until 4 frames before its heel-off event (the smoothed roll rises just ahead of
+/// the rule) and reaches 1.26 mm at that event's frame, listed in `KNOWN` with its bound.
 #[test]
 #[ignore = "slow (121 walks, ≈ 5 s in release on 2 cores); CI runs it with --ignored"]
 fn the_slow_stance_heel_stays_down_between_the_grid_points() {
     // (km/h, height): measured highest heel, m.
-    const KNOWN: &[(f64, f64, f64)] = &[(1.4, 1.6, 0.00399)];
+    const KNOWN: &[(f64, f64, f64)] = &[(1.4, 1.6, 0.00126)];
     let cases: Vec<(f64, f64)> = (0..=10)
         .flat_map(|i| (0..=10).map(move |j| (1.0 + 0.1 * f64::from(i), 1.5 + 0.05 * f64::from(j))))
         .collect();

@@ -78,10 +78,19 @@ pub const KNEE_LAND_EASE: f64 = 0.03;
 /// [`KNEE_EASE_SOFT`] left 1 km/h × 1.6 m's knee stopping dead at heel off (6.81; its landing
 /// narrows the margin to ≈ 0.6 mm). Cost: where the landing knee still *flexes* (1 km/h ×
 /// 1.5 m, ≈ 4 rad/s) the ease carries it on past the rule's peak (0.18 rad against 0.135), the
-/// foot rolls for it and, its roll never decreasing, keeps the heel 4.07 mm up through
+/// foot rolled for it and, its roll never decreasing, kept the heel 4.07 mm up through
 /// midstance (2.32 mm before; 1.8/2.0 m unchanged, 3.17/3.52). A 15 ms ease for flexing
 /// landings only, or no rocker ease for them, put 1 km/h × 1.5 m from standing at 5.25, 1.5
 /// km/h × 1.5 m at 6.27 (steady) or left 1.6 m at 6.81.
+///
+/// While the foot is flat the eased knee is now never more flexed than the flat foot's rule
+/// allows (its span never shorter than the rule's): the ease may carry the landing's rate on,
+/// but not roll the foot onto its ball. Since the slowest stances lower the hip
+/// (`generate::SLOW_REST_REACH`) the overshoot lifted the heel at foot flat in one walk of
+/// 1.0–2.0 km/h every 0.1 × 1.5–2.0 m every 5 cm (1.4 km/h × 1.6 m, whose rocker lands with the
+/// knee flexing at 4.9 rad/s: heel off at foot flat, 3.98 mm through midstance); with the bound
+/// its heel stays down until 4 frames before its heel off, continuity 3.25 → 3.47; every other
+/// walk of the dense grids (1–7 km/h, 1232 walks) and the 243-walk sweep is unchanged.
 pub const KNEE_ROCKER_EASE: f64 = 0.05;
 
 /// The knee was eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
@@ -972,7 +981,14 @@ impl VirtualLeg {
                 || self.ease_from_landing
                 || self.ease_from_rocker
             {
-                self.eased_span(t, d_t)
+                let eased = self.eased_span(t, d_t);
+                // While the foot is flat the eased knee is never more flexed than the flat
+                // foot's own (the span never shorter than the rule's), see `KNEE_ROCKER_EASE`.
+                if self.period == FootPeriod::Flat {
+                    eased.max(d_t)
+                } else {
+                    eased
+                }
             } else {
                 d_t
             };
