@@ -1628,7 +1628,20 @@ fn assemble(
             .enumerate()
         {
             if let Some(tt) = tr[j] {
-                events.push(ev(d.start + tt, d.side, *kind));
+                let t = if *kind == EventKind::HeelOff {
+                    // Where the drawn heel leaves the floor, in this stance or the next step's
+                    // double support (see `drawn_heel_off`).
+                    let flat = d.start + tr[0].unwrap_or(0.0);
+                    drawn_heel_off(&d.stance_rho, d.start, flat)
+                        .or_else(|| {
+                            data.get(k + 1)
+                                .and_then(|n| drawn_heel_off(&n.trail_rho, n.start, flat))
+                        })
+                        .unwrap_or(d.start + tt)
+                } else {
+                    d.start + tt
+                };
+                events.push(ev(t, d.side, *kind));
             }
         }
         let tr = d.trail_leg.transitions;
@@ -1639,6 +1652,19 @@ fn assemble(
         {
             if let Some(tt) = tr[j] {
                 let g = prev_start + tt;
+                // A trailing leg's heel off is its own stance's event (above), but for the
+                // walk's first trailing leg, whose stance is not recorded.
+                if *kind == EventKind::HeelOff && k > 0 {
+                    continue;
+                }
+                let g = if *kind == EventKind::HeelOff {
+                    match d.trail_rho.first() {
+                        Some(&(_, r0)) if r0 > HEEL_OFF_ROLL => continue,
+                        _ => drawn_heel_off(&d.trail_rho, d.start, f64::NEG_INFINITY).unwrap_or(g),
+                    }
+                } else {
+                    g
+                };
                 if g >= d.start - 1e-12 && g <= d.start + d.times.double_support + 1e-12 {
                     events.push(ev(g, d.side.opposite(), *kind));
                 }
@@ -1681,6 +1707,28 @@ fn assemble(
     });
     motion.events = events;
     Ok(motion)
+}
+
+/// The foot's roll (rad) above which the drawn heel is off the floor for the heel-off event
+/// (`drawn_heel_off`): ≈ 0.2 mm of heel for a 0.18 m heel–ball length, below which the heel
+/// is drawn on the floor within the checks' tolerances.
+const HEEL_OFF_ROLL: f64 = 1e-3;
+
+/// The time (global, s) of the first recorded roll sample (`(t, ρ)` on the clock starting at
+/// `start`) at or after `after` whose roll exceeds [`HEEL_OFF_ROLL`]: where the drawn heel
+/// leaves the floor.
+///
+/// Why not the heel-off rule's switch (`VirtualLeg::transitions`): the rule's period begins
+/// when the ankle reaches its dorsiflexion limit or the foot must roll, but the drawn roll is
+/// the least-bending curve above the rule's (`smooth_roll`, `hold_knees`), which can stay flat
+/// well past the switch: the event came 5–14 frames (3–7 km/h) and up to 46 frames (1–2 km/h ×
+/// 1.8–2.0 m) before the drawn heel was 0.2 mm up, and a few frames after it in 1.4 km/h ×
+/// 1.6 m. `EventKind::HeelOff` is documented as the heel leaving the ground.
+fn drawn_heel_off(rho: &[(f64, f64)], start: f64, after: f64) -> Option<f64> {
+    rho.iter()
+        .map(|&(t, r)| (start + t, r))
+        .find(|&(g, r)| g >= after - 1e-12 && r > HEEL_OFF_ROLL)
+        .map(|(g, _)| g)
 }
 
 /// One frame of the stop ([`Closing`]): pelvis level and unrotated, trunk returning to its lean,
