@@ -319,8 +319,9 @@ fn num_err(stage: String, message: String) -> GenerateError {
 /// keeps it down: ≤ 0.09 mm over 1.0–2.5 km/h × 1.5–2.0 m every 5 cm except 1.4 km/h × 1.6 m
 /// (3.98 mm: its rocker landing, chosen by the slow-start rule of
 /// `VirtualLeg::plan_heel_rocker` at a threshold, reaches foot flat with the knee still
-/// flexing at 4.9 rad/s, and the ankle meets its dorsiflexion limit there), the heel rising at
-/// 33–36 % of the cycle at 1 km/h (human 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
+/// flexing at 4.9 rad/s; down since the knee ease is bounded by the flat foot's knee,
+/// `virtual_leg::KNEE_ROCKER_EASE`), the heel rising at 33–36 % of the cycle at 1 km/h (human
+/// 30–40 %). Measured cost (continuity, k = 5; 1.0–2.5 km/h every
 /// 0.05 × 1.5–2.0 m every 5 cm, 341 steady walks and 176 from standing with a stop): alone,
 /// 0 → 2 and 1 → 1 walks over 5 (1.05 km/h × 1.50 m 5.12, 1.10 × 1.55 m 5.08 steady and 5.09
 /// from standing, l_knee: the trailing knee, see `hold_knees`; the stop's 1.8 km/h × 2.0 m 5.14
