@@ -44,9 +44,8 @@
 //! assert!((r.mu(2, x) - r.mu_star()[2]).abs() < 1e-15);
 //! assert_eq!(r.outputs(), 4);
 //! ```
-use super::required;
 use super::{
-    expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;

@@ -19,11 +19,10 @@
 //! assert!((r.step_length(200.0, 1.8, 0.0) - 1.0694).abs() < 1e-9);
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
-use super::required;
 use super::{
-    expect_id, linear_gradient, sorted_keys, Citation, CoefficientSet, Domain, KeyRange, KeyScale,
-    KeySums, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection, Relation,
-    RelationError, SortedProfile, SubjectEffect, Variable,
+    expect_id, linear_gradient, required, sorted_keys, Citation, CoefficientSet, Domain, KeyRange,
+    KeyScale, KeySums, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection,
+    Relation, RelationError, SortedProfile, SubjectEffect, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;

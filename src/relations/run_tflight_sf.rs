@@ -30,11 +30,10 @@
 //! assert!((r.flight_time(187.0) - 0.188).abs() < 0.0005); // running paper §3.1
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
-use super::required;
 use super::{
-    expect_id, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, KeyRange, KeyScale,
-    KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection,
-    Relation, RelationError, SortedProfile, Variable,
+    expect_id, required, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, KeyRange,
+    KeyScale, KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec, Plan,
+    Rejection, Relation, RelationError, SortedProfile, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;

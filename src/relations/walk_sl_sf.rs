@@ -17,9 +17,8 @@
 //! assert!((w.step_freq_for_speed(v, 1.8) - 107.58).abs() < 0.01);
 //! assert!((w.step_length_for_speed(v, 1.8) - 0.7746).abs() < 0.0005);
 //! ```
-use super::required;
 use super::{
-    expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;

@@ -16,9 +16,8 @@
 //! // t_ds at 120 steps/min: (29.08 − 19.2) % of a 1 s cycle = 0.0988 s.
 //! assert!((w.double_support_time(120.0) - 0.0988).abs() < 1e-12);
 //! ```
-use super::required;
 use super::{
-    expect_id, linear_gradient, Citation, CoefficientSet, Domain, Observation, ParamKind,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
     ParameterSpec, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;

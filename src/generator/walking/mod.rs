@@ -21,13 +21,15 @@
 //!
 //! **Continuity caveat.** Steady walks of 1–7 km/h × 1.5–2.0 m meet the smoothness check
 //! [`crate::generator::checks::continuity`] at k = 5 (every frame-to-frame step within 5 × the
-//! median of its neighbours), except 7 km/h × 1.5 m: 5.29 steady (the ankle at every heel
-//! strike), 5.62 from standing; from standing 4 km/h × 1.5 m also reaches 5.17 (measured on
-//! main b68aea6, 8 steps, 100 frames/s). 7 km/h × 1.5 m is measured *above the walk–run
-//! transition*: its Froude number `v²/(g·l1)` is 0.53 > [`high_level::WALK_RUN_FROUDE`]
-//! (eq. 1 gives it a step of 1.16 × the leg, an inter-leg angle of 67° at heel strike), a
-//! speed at which a person of that height runs; its report carries a note saying so
-//! ([`high_level::walk_run_note`]).
+//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.29 steady
+//! (the ankle at every heel strike), 5.56 from standing with a stop, and on a 0.1 km/h × 5 cm
+//! grid 6.7–7.0 km/h × 1.5–1.6 m (5.04–5.29) and 3.3 km/h × 1.55 m (5.02, the landing knee);
+//! measured on main 40536a7, 8 steps, 100 frames/s (`tests/klaw_continuity.rs`). The landing
+//! knee, locked straight in swing3 as in the paper, starts flexing at 2–3 × its mean rate at
+//! heel strike. 7 km/h × 1.5 m is *above the walk–run transition*: its Froude number
+//! `v²/(g·l1)` is 0.53 > [`high_level::WALK_RUN_FROUDE`] (eq. 1 gives it a step of 1.16 × the
+//! leg, an inter-leg angle of 67° at heel strike), a speed at which a person of that height
+//! runs; its report carries a note saying so ([`high_level::walk_run_note`]).
 //!
 //! The equations of motion are checked against an independent Lagrangian derivation
 //! ([`lagrange`]); the corrections to the printed equations are listed in [`dynamics`]. The

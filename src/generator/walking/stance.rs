@@ -173,8 +173,9 @@ pub struct StanceSpec {
 }
 
 /// Fraction of the stance over which the leg spring's shortened rest length ramps in from
-/// heel strike ([`StanceSpec::rest_length`]) at 2 km/h and up; the slowest walks ramp it in over
-/// [`REST_RAMP_IN_SLOW`]. Measured against 0.1 (2 km/h, 8 steps): the heel ≤ 0.29 mm against
+/// heel strike ([`StanceSpec::rest_length`]) from Froude speed 0.20 up (≈ 2 km/h at 1.8 m); the
+/// slowest walks ramp it in over [`REST_RAMP_IN_SLOW`] (blended between, see
+/// `generate::SLOW_REST_FROUDE`). Measured against 0.1 (2 km/h, 8 steps): the heel ≤ 0.29 mm against
 /// 0.00 mm, but the knee a few frames after foot flat 2.9/2.8/2.7 against 3.5/2.9/2.8 at
 /// 1.5/1.8/2.0 m, and from standing at 1.5 m 2.9 against 3.6.
 pub const REST_RAMP_IN: f64 = 0.2;
