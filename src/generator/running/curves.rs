@@ -28,6 +28,28 @@ pub fn hermite(t0: f64, t1: f64, p0: f64, p1: f64, m0: f64, m1: f64, t: f64) -> 
     (v, d)
 }
 
+/// [`hermite`] with the second derivative: value, first and second derivative at `t` (the
+/// walking generator's swing thigh path needs the acceleration, `walking::swing`).
+pub fn hermite_acc(
+    t0: f64,
+    t1: f64,
+    p0: f64,
+    p1: f64,
+    m0: f64,
+    m1: f64,
+    t: f64,
+) -> (f64, f64, f64) {
+    let (v, d) = hermite(t0, t1, p0, p1, m0, m1, t);
+    let h = t1 - t0;
+    if h <= 0.0 {
+        return (v, d, 0.0);
+    }
+    let s = ((t - t0) / h).clamp(0.0, 1.0);
+    let dd = ((12.0 * s - 6.0) * (p0 - p1)) / (h * h)
+        + ((6.0 * s - 4.0) * m0 + (6.0 * s - 2.0) * m1) / h;
+    (v, d, dd)
+}
+
 /// 3-D cubic Hermite segment.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Seg3 {
@@ -231,6 +253,25 @@ impl Track {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn hermite_acc_is_the_derivative_of_the_rate() {
+        let (t0, t1, p0, p1, m0, m1) = (0.2, 0.7, 0.3, -0.4, 1.5, 2.5);
+        for k in 0..=10 {
+            let t = t0 + (t1 - t0) * f64::from(k) / 10.0;
+            let (v, d, dd) = hermite_acc(t0, t1, p0, p1, m0, m1, t);
+            assert_eq!((v, d), hermite(t0, t1, p0, p1, m0, m1, t));
+            let e = 1e-6;
+            let (ta, tb) = ((t - e).max(t0), (t + e).min(t1));
+            let num = (hermite(t0, t1, p0, p1, m0, m1, tb).1
+                - hermite(t0, t1, p0, p1, m0, m1, ta).1)
+                / (tb - ta);
+            assert!(
+                (dd - num).abs() < 1e-5 * (1.0 + num.abs()),
+                "{t}: {dd} vs {num}"
+            );
+        }
+    }
 
     #[test]
     fn hermite_hits_ends_and_slopes() {

@@ -583,17 +583,11 @@ impl ThighPath {
 }
 
 /// The cubic Hermite from `(value, rate)` `p0` at `a` to `p1` at `b`: value, rate and
-/// acceleration at `t`.
+/// acceleration at `t` ([`crate::generator::running::curves::hermite_acc`]).
 fn hermite(a: f64, b: f64, p0: [f64; 2], p1: [f64; 2], t: f64) -> [f64; 3] {
-    let big_t = b - a;
-    let s = ((t - a) / big_t).clamp(0.0, 1.0);
-    let (s2, s3) = (s * s, s * s * s);
-    let d = p1[0] - p0[0];
-    let (m0, m1) = (p0[1] * big_t, p1[1] * big_t);
-    let v = p0[0] + d * (3.0 * s2 - 2.0 * s3) + m0 * (s3 - 2.0 * s2 + s) + m1 * (s3 - s2);
-    let dv = d * (6.0 * s - 6.0 * s2) + m0 * (3.0 * s2 - 4.0 * s + 1.0) + m1 * (3.0 * s2 - 2.0 * s);
-    let ddv = d * (6.0 - 12.0 * s) + m0 * (6.0 * s - 4.0) + m1 * (6.0 * s - 2.0);
-    [v, dv / big_t, ddv / (big_t * big_t)]
+    let (v, d, dd) =
+        crate::generator::running::curves::hermite_acc(a, b, p0[0], p1[0], p0[1], p1[1], t);
+    [v, d, dd]
 }
 
 /// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
