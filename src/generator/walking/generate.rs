@@ -372,11 +372,12 @@ fn projected_lock(speed: f64, l1: f64, from_rest: bool, to_rest: bool) -> bool {
     !from_rest && (!to_rest || edge_lock(froude)) && froude < PROJECTED_LOCK_FROUDE_MAX
 }
 
-/// The rest length's shortening in units of the projected reach at Froude speed `froude`:
-/// [`SLOW_REST_REACH`] up to [`SLOW_REST_FROUDE`]`[0]`, 1 from [`SLOW_REST_FROUDE`]`[1]`.
-fn slow_rest_factor(froude: f64) -> f64 {
+/// The weight of the slowest walks' settings ([`SLOW_REST_REACH`],
+/// [`super::stance::REST_RAMP_IN_SLOW`]) at Froude speed `froude`: 1 up to
+/// [`SLOW_REST_FROUDE`]`[0]`, 0 from [`SLOW_REST_FROUDE`]`[1]`, a smoothstep between.
+fn slowness(froude: f64) -> f64 {
     let [lo, hi] = SLOW_REST_FROUDE;
-    1.0 + (SLOW_REST_REACH - 1.0) * smoothstep(((hi - froude) / (hi - lo)).clamp(0.0, 1.0))
+    smoothstep(((hi - froude) / (hi - lo)).clamp(0.0, 1.0))
 }
 
 /// Whether the last stance before a stop locks at the projected length (and shortens its rest
@@ -754,14 +755,13 @@ pub fn generate_steps(
             lock_reach: if projected { flat_reach } else { 0.0 },
             flat_reach,
             rest_reach: if projected && slow {
-                flat_reach * slow_rest_factor(froude)
+                flat_reach * (1.0 + (SLOW_REST_REACH - 1.0) * slowness(froude))
             } else {
                 0.0
             },
             rest_ramp_in: super::stance::REST_RAMP_IN
                 + (super::stance::REST_RAMP_IN_SLOW - super::stance::REST_RAMP_IN)
-                    * (slow_rest_factor(froude) - 1.0)
-                    / (SLOW_REST_REACH - 1.0),
+                    * slowness(froude),
             ..spec
         };
         let (st_solved, st_run) = spec
@@ -1397,8 +1397,8 @@ fn hold_knees(data: &mut [StepData]) {
                 Some(*m)
             })
             .collect();
-        let hold = |floor: &mut Vec<f64>| -> Option<Vec<f64>> {
-            smooth_roll(&times, floor, 0, false, KNEE_HOLD_TAU);
+        let hold = |mut floor: Vec<f64>| -> Option<Vec<f64>> {
+            smooth_roll(&times, &mut floor, 0, false, KNEE_HOLD_TAU);
             let mut held = vec![sample(data, &chain[0]).3];
             for (j, s) in chain.iter().enumerate().skip(1) {
                 let (leg, hip, dz, r) = sample(data, s);
@@ -1422,8 +1422,7 @@ fn hold_knees(data: &mut [StepData]) {
         // trailing knee stays near the heel-off rule's soft floor to toe off), a floor that
         // never decreases would need the toe-off samples: the floor then descends linearly
         // from the peak to the toe-off knee.
-        let mut floor = prefix_max.clone();
-        let held = hold(&mut floor).or_else(|| {
+        let Some(held) = hold(prefix_max.clone()).or_else(|| {
             let n = prefix_max.len();
             let (t_end, k_end) = (times[n - 2], knees[i0 + n - 2]);
             let peak = (0..n).find(|&j| prefix_max[j] >= prefix_max[n - 1])?;
@@ -1431,7 +1430,7 @@ fn hold_knees(data: &mut [StepData]) {
             if t_end <= t_peak + 1e-9 {
                 return None;
             }
-            let mut floor: Vec<f64> = (0..n)
+            let floor: Vec<f64> = (0..n)
                 .map(|j| {
                     let line = k_peak
                         + (k_end - k_peak)
@@ -1439,13 +1438,10 @@ fn hold_knees(data: &mut [StepData]) {
                     prefix_max[j].min(line.max(k_end))
                 })
                 .collect();
-            hold(&mut floor)
-        });
-        let ok = held.is_some();
-        let held = held.unwrap_or_default();
-        if !ok {
+            hold(floor)
+        }) else {
             continue;
-        }
+        };
         let mut stance_last = None;
         for (&(k, trail, i), &r) in chain.iter().zip(&held) {
             if trail {
@@ -1624,26 +1620,28 @@ fn assemble(
             EventKind::ToeOff,
         ));
         let tr = d.stance_leg.transitions;
-        for (j, kind) in [EventKind::FootFlat, EventKind::HeelOff, EventKind::MetaOff]
-            .iter()
-            .enumerate()
-        {
+        for (j, kind) in [(0, EventKind::FootFlat), (2, EventKind::MetaOff)] {
             if let Some(tt) = tr[j] {
-                let t = if *kind == EventKind::HeelOff {
-                    // Where the drawn heel leaves the floor, in this stance or the next step's
-                    // double support (see `drawn_heel_off`).
-                    let flat = d.start + tr[0].unwrap_or(0.0);
-                    drawn_heel_off(&d.stance_rho, d.start, flat)
-                        .or_else(|| {
-                            data.get(k + 1)
-                                .and_then(|n| drawn_heel_off(&n.trail_rho, n.start, flat))
-                        })
-                        .unwrap_or(d.start + tt)
-                } else {
-                    d.start + tt
-                };
-                events.push(ev(t, d.side, *kind));
+                events.push(ev(d.start + tt, d.side, kind));
             }
+        }
+        // This stance leg's heel off, once, wherever the rule switches (in the stance, in the
+        // next step's double support, or in the stop's): where the drawn heel leaves the floor
+        // in the stance or that double support (`drawn_heel_off`), else the rule's switch.
+        let next = data.get(k + 1);
+        let rule = tr[1].map(|tt| d.start + tt).or_else(|| match next {
+            Some(n) => n.trail_leg.transitions[1]
+                .map(|tt| n.trail_origin + tt)
+                .filter(|&g| g <= n.start + n.times.double_support + 1e-12),
+            None => closing.and_then(|c| c.trail_transitions[0].map(|tt| c.start + tt)),
+        });
+        if let Some(rule) = rule {
+            let flat = d.start + tr[0].unwrap_or(0.0);
+            let drawn = drawn_heel_off(&d.stance_rho, d.start, flat).or_else(|| match next {
+                Some(n) => drawn_heel_off(&n.trail_rho, n.start, flat),
+                None => closing.and_then(|c| drawn_heel_off(c.trail_rho(), c.start, flat)),
+            });
+            events.push(ev(drawn.unwrap_or(rule), d.side, EventKind::HeelOff));
         }
         let tr = d.trail_leg.transitions;
         let prev_start = d.trail_origin;
@@ -1684,14 +1682,9 @@ fn assemble(
         if let Some(tf) = c.stance_flat {
             events.push(ev(c.start + tf, w, EventKind::FootFlat));
         }
-        for (tt, kind) in c
-            .trail_transitions
-            .iter()
-            .zip([EventKind::HeelOff, EventKind::MetaOff])
-        {
-            if let Some(tt) = tt {
-                events.push(ev(c.start + tt, tr, kind));
-            }
+        // The trailing leg's heel off is its last stance's event (above).
+        if let Some(tt) = c.trail_transitions[1] {
+            events.push(ev(c.start + tt, tr, EventKind::MetaOff));
         }
         events.push(ev(c.start + c.toe_off, tr, EventKind::ToeOff));
         // The trailing foot lands flat beside the stance foot: heel strike and foot flat at once.

@@ -373,6 +373,12 @@ impl Closing {
         }
     }
 
+    /// The trailing foot's drawn roll through the double support, `(t, ρ)` on the closing's
+    /// clock (from [`Closing::start`]).
+    pub fn trail_rho(&self) -> &[(f64, f64)] {
+        &self.trail_rho
+    }
+
     /// Pelvis centre (dynamic hip x, y) and lateral position at `t`.
     fn hip_at(&self, t: f64) -> ([f64; 2], f64) {
         let g = &self.geo;
