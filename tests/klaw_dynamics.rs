@@ -155,6 +155,10 @@ fn energy_is_conserved_with_forces_and_damping_off() {
             worst = worst.max((energy(y) - e0).abs());
         });
     assert!(end.t == duration);
+    println!(
+        "stance: relative energy drift over the step {:.2e}",
+        worst / e0.abs()
+    );
     assert!(
         worst / e0.abs() < 1e-6,
         "stance: relative drift {}",
@@ -174,6 +178,10 @@ fn energy_is_conserved_with_forces_and_damping_off() {
     integrate::<6, _, NoEvent<6>, _>(&mut fs, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
         worst = worst.max((energy_s(y) - e0).abs());
     });
+    println!(
+        "stance with spring: relative energy drift over the step {:.2e}",
+        worst / e0.abs()
+    );
     assert!(
         worst / e0.abs() < 1e-6,
         "stance with spring: relative drift {}",
@@ -195,6 +203,10 @@ fn energy_is_conserved_with_forces_and_damping_off() {
     integrate::<4, _, NoEvent<4>, _>(&mut fw, 0.0, y0, duration, h, None, &mut |_, _, _, y| {
         worst = worst.max((energy_w(y) - e0).abs());
     });
+    println!(
+        "swing: relative energy drift over the step {:.2e}",
+        worst / e0.abs()
+    );
     assert!(
         worst / e0.abs() < 1e-6,
         "swing: relative drift {}",
