@@ -14,6 +14,7 @@
 //! Layout (one module per concept):
 //! - [`units`]: unit-suffixed column names (`speed_m_per_s`, …) → SI, and back to the papers'
 //!   units (m/min, steps/min);
+//! - [`gait`]: the shared vocabulary (side, gait, event kinds and sources), a leaf module;
 //! - [`ingest`]: readers (trial tables, TRC, MOT/STO, Cortex `.forces`, treadmill GRF, C3D,
 //!   Winter's rotoscope table) → typed in-memory tables;
 //! - [`events`]: gait event detection and per-step spatiotemporal tables;
@@ -33,6 +34,7 @@ pub mod events;
 pub mod export;
 pub mod fit;
 pub mod fsio;
+pub mod gait;
 pub mod generator;
 pub mod ingest;
 pub mod relations;

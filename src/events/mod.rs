@@ -24,11 +24,10 @@ pub mod phases;
 pub mod plot;
 pub mod steps;
 pub mod synthetic;
-pub mod types;
 
+pub use crate::gait::{EventKind, EventSource, Gait, GaitEvent, Side};
 pub use markers::MarkerMap;
 pub use steps::{steps_from_analysis, Analysis, StepExtra, StepTable};
-pub use types::{EventKind, EventSource, Gait, GaitEvent, Side};
 
 use crate::ingest::types::{Setting, Trial};
 use serde::{Deserialize, Serialize};

@@ -48,7 +48,7 @@ use super::frame_detect;
 use super::text;
 use super::types::{ForcePlate, MarkerSet, Trial};
 use super::{finish, IngestError, ReadOptions};
-use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
+use crate::gait::{EventKind, EventSource, Gait, GaitEvent, Side};
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -29,7 +29,7 @@ use super::frame_detect::Direction;
 use super::text::{self, Num};
 use super::types::{Axis, ForcePlate, MarkerSet, Setting, Trial};
 use super::{finish, IngestError, ReadOptions};
-use crate::events::{Gait, Side};
+use crate::gait::{Gait, Side};
 use std::path::Path;
 
 #[derive(Debug, Clone, Copy, PartialEq)]

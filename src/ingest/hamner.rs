@@ -17,7 +17,7 @@ use super::frame_detect;
 use super::trc;
 use super::types::{MarkerSet, Setting, Trial};
 use super::{IngestError, ReadOptions};
-use crate::events::Gait;
+use crate::gait::Gait;
 use std::path::Path;
 
 /// Leg (thigh + shank) length as a fraction of body height, Bruderlin & Calvert (1989) Table B-1.

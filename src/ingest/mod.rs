@@ -21,7 +21,7 @@ pub mod trials;
 pub mod types;
 pub mod winter;
 
-use crate::events::Gait;
+use crate::gait::Gait;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 use types::{Axis, Setting, Trial};
@@ -79,6 +79,9 @@ pub enum IngestError {
         /// The accepted spellings.
         message: String,
     },
+    /// Writing a table failed (the destination is left untouched).
+    #[error(transparent)]
+    Write(#[from] crate::fsio::FsError),
 }
 
 impl IngestError {

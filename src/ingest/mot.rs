@@ -22,7 +22,7 @@ use super::frame_detect;
 use super::text::{self, Num};
 use super::types::{ForcePlate, Trial};
 use super::{finish, hamner, IngestError, ReadOptions};
-use crate::events::{Gait, Side};
+use crate::gait::{Gait, Side};
 use std::path::Path;
 
 /// A MOT/STO table in SI units (angles in radians when the file says `inDegrees=yes`).

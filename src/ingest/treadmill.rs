@@ -25,7 +25,7 @@ use super::frame_detect;
 use super::text::{self, Num};
 use super::types::{ForcePlate, Setting, Trial};
 use super::{finish, IngestError, ReadOptions};
-use crate::events::{Gait, Side};
+use crate::gait::{Gait, Side};
 use std::path::Path;
 
 /// The GRF sampling rate of the WBDS treadmill files, Hz (Fukuchi et al. 2018).

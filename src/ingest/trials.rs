@@ -15,7 +15,7 @@
 //! frequency triple from any two of them (v = sl·sf), derives the double-support percentage from
 //! the double-support time and the step frequency when only the time is given, and **flags** (does
 //! not silently use) rows whose given values disagree by more than [`CONSISTENCY_TOLERANCE`].
-use crate::events::{Gait, Side};
+use crate::gait::{Gait, Side};
 use crate::ingest::IngestError;
 use crate::units::{parse_header, Column, Quantity};
 use serde::{Deserialize, Serialize};
@@ -1047,7 +1047,7 @@ fn number(
 
 /// Writes rows as a trials CSV with the [`CANONICAL_COLUMNS`] (SI headers; step frequency in
 /// steps/min and angles in degrees, as the canonical headers say), atomically.
-pub fn write_trials(path: &Path, rows: &[StepRow]) -> crate::Result<()> {
+pub fn write_trials(path: &Path, rows: &[StepRow]) -> Result<(), IngestError> {
     use crate::fsio::FsError;
     crate::fsio::write_atomic(path, |w| {
         let mut wtr = csv::Writer::from_writer(w);
@@ -1077,7 +1077,7 @@ pub fn write_trials(path: &Path, rows: &[StepRow]) -> crate::Result<()> {
             wtr.write_record(&rec).map_err(io)?;
         }
         wtr.flush().map_err(|e| FsError::io(path, e))?;
-        Ok::<(), crate::Error>(())
+        Ok::<(), IngestError>(())
     })
 }
 

@@ -1,6 +1,6 @@
 //! In-memory measured data, in SI units (m, N, N·m, s), in the laboratory frame of the file with
 //! its axes identified. Every reader produces a [`Trial`].
-use crate::events::{Gait, GaitEvent, Side};
+use crate::gait::{Gait, GaitEvent, Side};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 

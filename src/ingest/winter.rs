@@ -22,7 +22,7 @@ use super::frame_detect::Direction;
 use super::text::{self, Num};
 use super::types::{Axis, MarkerSet, Setting, Trial};
 use super::{finish, IngestError, ReadOptions};
-use crate::events::Gait;
+use crate::gait::Gait;
 use std::path::Path;
 
 /// Winter's film rate, Hz (Winter, Table A.1: Δt = 0.0143 s).

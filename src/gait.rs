@@ -1,4 +1,6 @@
-//! Small vocabulary shared by every layer: body side, gait, event kinds and sources.
+//! The gait vocabulary shared by every layer: body side, gait, event kinds and sources. A leaf
+//! module: it imports nothing from the crate, so readers ([`crate::ingest`]) and detectors
+//! ([`crate::events`]) both build on it without importing each other.
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
