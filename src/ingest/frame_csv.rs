@@ -24,12 +24,23 @@
 //!   reaction on the body —, optional `<plate>_cop_x_<u>` … (length units as above) and
 //!   `<plate>_tz_n_m` (or `_n_mm`), the free moment about the vertical. A plate named `r…`/
 //!   `right…` (`l…`/`left…`) carries that foot only. Force cells must be finite.
+//! - Contact columns `l_contact`, `r_contact` (0/1, as gaitfit's generators write them): the
+//!   writer's own contact state of that foot. They become reference events of source
+//!   [`EventSource::Generated`](crate::gait::EventSource::Generated) (a heel strike where a foot's flag turns 1, a toe off where it
+//!   turns 0, at the first frame of the new state): kept for comparison, never used in place of
+//!   detection (the point of reading a generated motion back is to measure it).
+//! - Angle columns `<name>_x_deg`, `<name>_y_deg`, `<name>_z_deg` (or `_rad`), e.g. the
+//!   generators' joint angles: checked to be numbers, counted in the notes, not used by event
+//!   detection.
 //! - Any other column is an error naming it (so a misspelt unit is never silently dropped).
+//!
+//! So the motion CSV that `gaitfit generate … -o motion.csv` writes
+//! ([`crate::export::motion_csv`]) reads back as a trial of its landmarks (metres).
 use super::frame_detect::Direction;
 use super::text::{self, Num};
 use super::types::{Axis, ForcePlate, MarkerSet, Setting, Trial};
 use super::{finish, IngestError, ReadOptions};
-use crate::gait::{Gait, Side};
+use crate::gait::{EventKind, EventSource, Gait, GaitEvent, Side};
 use std::path::Path;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,6 +50,10 @@ enum Role {
     Force(usize, usize, f64),
     Cop(usize, usize, f64),
     Moment(usize, f64),
+    /// A foot's 0/1 contact flag.
+    Contact(Side),
+    /// A joint angle (validated, not kept).
+    Angle,
 }
 
 fn axis_of(s: &str) -> Option<Axis> {
@@ -101,6 +116,17 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
             });
             continue;
         }
+        match lower.as_str() {
+            "l_contact" | "left_contact" => {
+                roles.push(Role::Contact(Side::Left));
+                continue;
+            }
+            "r_contact" | "right_contact" => {
+                roles.push(Role::Contact(Side::Right));
+                continue;
+            }
+            _ => {}
+        }
         let parts: Vec<&str> = lower.rsplitn(4, '_').collect(); // reversed
         let index_of = |list: &mut Vec<String>, n: &str| -> usize {
             list.iter().position(|x| x == n).unwrap_or_else(|| {
@@ -146,6 +172,11 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
                 roles.push(Role::Force(p, ax.index(), s));
                 continue;
             }
+            // <joint>_<axis>_deg|rad
+            if axis_of(comp).is_some() && matches!(unit, "deg" | "rad") {
+                roles.push(Role::Angle);
+                continue;
+            }
             // <marker>_<axis>_<unit>
             if let Some(ax) = axis_of(comp) {
                 let s = text::length_scale(unit)
@@ -161,7 +192,7 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
             hl,
             name.clone(),
             "not a per-frame column: expected <marker>_x_mm, <plate>_fy_n, <plate>_cop_x_mm or \
-             <plate>_tz_n_m (see ingest::frame_csv)",
+             <plate>_tz_n_m, l_contact/r_contact or <joint>_x_deg (see ingest::frame_csv)",
         ));
     }
     // Each plate needs its three force components.
@@ -193,6 +224,14 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
     let mut cop: Vec<Vec<[f64; 3]>> = vec![Vec::new(); plates.len()];
     let mut moment: Vec<Vec<f64>> = vec![Vec::new(); plates.len()];
     let mut has_cop = vec![false; plates.len()];
+    // Per foot (left, right): the contact flag of the previous row, and the events it implies.
+    let mut contact_prev: [Option<bool>; 2] = [None, None];
+    let mut contact_events: Vec<GaitEvent> = Vec::new();
+    let n_contact = roles
+        .iter()
+        .filter(|r| matches!(r, Role::Contact(_)))
+        .count();
+    let n_angle = roles.iter().filter(|r| matches!(r, Role::Angle)).count();
     for (ln, line) in it {
         if text::is_blank(line) {
             continue;
@@ -260,6 +299,47 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
                         *last = v;
                     }
                 }
+                Role::Contact(side) => {
+                    let v = text::finite(cell, path, ln, &names[c])?;
+                    let on = match v {
+                        x if x == 0.0 => false,
+                        x if x == 1.0 => true,
+                        _ => {
+                            return Err(IngestError::cell(
+                                path,
+                                ln,
+                                names[c].clone(),
+                                format!("{v} is not a contact flag (0 or 1)"),
+                            ))
+                        }
+                    };
+                    let k = usize::from(side == Side::Right);
+                    if let (Some(prev), Some(&t)) = (contact_prev[k], time.last()) {
+                        if prev != on {
+                            contact_events.push(GaitEvent {
+                                time_s: t,
+                                side,
+                                kind: if on {
+                                    EventKind::HeelStrike
+                                } else {
+                                    EventKind::ToeOff
+                                },
+                                source: EventSource::Generated,
+                            });
+                        }
+                    }
+                    contact_prev[k] = Some(on);
+                }
+                Role::Angle => {
+                    if matches!(text::num(cell), Num::Bad) {
+                        return Err(IngestError::cell(
+                            path,
+                            ln,
+                            names[c].clone(),
+                            format!("{:?} is not a number", text::text(cell)),
+                        ));
+                    }
+                }
             }
         }
         if n < ncol {
@@ -288,6 +368,20 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
         plates.len(),
         time.len()
     ));
+    if n_contact > 0 {
+        trial.notes.push(format!(
+            "{n_contact} contact column(s): {} contact change(s) kept as the writer's reference \
+             events (source generated; not used in place of detection)",
+            contact_events.len()
+        ));
+    }
+    if n_angle > 0 {
+        trial.notes.push(format!(
+            "{n_angle} angle column(s) read and checked; event detection does not use them"
+        ));
+    }
+    contact_events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    trial.reference_events = contact_events;
     if !markers.is_empty() {
         trial.markers = Some(MarkerSet {
             rate_hz: rate,
@@ -451,5 +545,50 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("speed"), "{e}");
+    }
+
+    #[test]
+    fn contact_and_angle_columns_of_the_motion_csv() {
+        let csv = "time_s,pelvis_x_m,pelvis_y_m,pelvis_z_m,l_contact,r_contact,l_knee_z_deg\n\
+            0.00,0.0,1.0,0.0,1,0,-5.0\n\
+            0.01,0.1,1.0,0.0,1,1,-6.0\n\
+            0.02,0.2,1.0,0.0,0,1,-7.5\n\
+            0.03,0.3,1.0,0.0,0,1,-9.0\n";
+        let t = parse(csv.as_bytes(), Path::new("m.csv"), &ReadOptions::default()).unwrap();
+        assert_eq!(t.markers.as_ref().unwrap().names, vec!["pelvis"]);
+        let ev: Vec<(f64, Side, EventKind, EventSource)> = t
+            .reference_events
+            .iter()
+            .map(|e| (e.time_s, e.side, e.kind, e.source))
+            .collect();
+        assert_eq!(
+            ev,
+            vec![
+                (
+                    0.01,
+                    Side::Right,
+                    EventKind::HeelStrike,
+                    EventSource::Generated
+                ),
+                (0.02, Side::Left, EventKind::ToeOff, EventSource::Generated),
+            ]
+        );
+        let p = Path::new("m.csv");
+        let e = parse(
+            csv.replace(",1,0,-5.0", ",2,0,-5.0").as_bytes(),
+            p,
+            &ReadOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("l_contact") && e.contains("0 or 1"), "{e}");
+        let e = parse(
+            csv.replace("-6.0", "x").as_bytes(),
+            p,
+            &ReadOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("l_knee_z_deg"), "{e}");
     }
 }
