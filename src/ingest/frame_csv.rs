@@ -301,17 +301,17 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
                 }
                 Role::Contact(side) => {
                     let v = text::finite(cell, path, ln, &names[c])?;
-                    let on = match v {
-                        x if x == 0.0 => false,
-                        x if x == 1.0 => true,
-                        _ => {
-                            return Err(IngestError::cell(
-                                path,
-                                ln,
-                                names[c].clone(),
-                                format!("{v} is not a contact flag (0 or 1)"),
-                            ))
-                        }
+                    let on = if v == 0.0 {
+                        false
+                    } else if v == 1.0 {
+                        true
+                    } else {
+                        return Err(IngestError::cell(
+                            path,
+                            ln,
+                            names[c].clone(),
+                            format!("{v} is not a contact flag (0 or 1)"),
+                        ));
                     };
                     let k = usize::from(side == Side::Right);
                     if let (Some(prev), Some(&t)) = (contact_prev[k], time.last()) {
