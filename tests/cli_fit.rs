@@ -173,7 +173,7 @@ fn fit_check_export_round_trip() {
         .unwrap();
     assert!(rs.status.success());
     let src = std::fs::read_to_string(d.join("coeffs.rs")).unwrap();
-    assert!(src.contains("pub const WALK_SL_SF_K: f64 ="));
+    assert!(src.contains("pub mod walk_sl_sf {") && src.contains("    pub const K: f64 ="));
     assert!(src.contains("/// `k` of `walk-sl-sf`"));
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
     let out = std::process::Command::new(rustc)
