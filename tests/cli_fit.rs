@@ -166,7 +166,8 @@ fn fit_check_export_round_trip() {
         toml::from_str(&std::fs::read_to_string(d.join("out/all.toml")).unwrap()).unwrap();
     assert!(t.get("walk-sl-sf").is_some());
 
-    // Rust: a self-contained module that compiles on its own.
+    // Rust: a module that compiles on its own (under a crate root that documents the crate;
+    // tests/export_coeffs.rs also checks include! and the values).
     let rs = gaitfit(d)
         .args(["export", "--format", "rust", "-o", "coeffs.rs"])
         .output()
@@ -175,6 +176,11 @@ fn fit_check_export_round_trip() {
     let src = std::fs::read_to_string(d.join("coeffs.rs")).unwrap();
     assert!(src.contains("pub mod walk_sl_sf {") && src.contains("    pub const K: f64 ="));
     assert!(src.contains("/// `k` of `walk-sl-sf`"));
+    std::fs::write(
+        d.join("wrapper.rs"),
+        "//! Wrapper.\n/// The export.\npub mod coeffs;\n",
+    )
+    .unwrap();
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
     let out = std::process::Command::new(rustc)
         .current_dir(d)
@@ -191,7 +197,7 @@ fn fit_check_export_round_trip() {
             "metadata",
             "-o",
             "coeffs.rmeta",
-            "coeffs.rs",
+            "wrapper.rs",
         ])
         .output()
         .unwrap();
