@@ -24,6 +24,7 @@
 //!   generators (running, walking, generalize);
 //! - [`export`]: coefficient tables (JSON/TOML/Rust/CSV) and motion files (BVH/CSV/TRC);
 //! - [`report`]: residual tables, plots and the summary document;
+//! - [`studio`]: the local web page for editing runs and walks live (`gaitfit studio`);
 //! - [`cli`]: the thin command-line layer used by the `gaitfit` binary.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
@@ -40,6 +41,7 @@ pub mod ingest;
 pub mod relations;
 pub mod report;
 pub mod shared_data;
+pub mod studio;
 pub mod units;
 
 pub use error::{Error, Result};

@@ -8,6 +8,7 @@ pub mod events;
 pub mod export;
 pub mod fit;
 pub mod generate;
+pub mod studio;
 
 /// gaitfit: fit the published gait relations of KLAW (1989), RUNNER (1996) and Ko–Badler
 /// (1993) to measured data, generate walking and running with the fitted coefficients, and
@@ -34,6 +35,8 @@ pub enum Command {
     Events(Box<events::Args>),
     /// Generate motion (running, walking, or a generalized measured walk).
     Generate(generate::Args),
+    /// Edit runs and walks live in a local web page (127.0.0.1 only).
+    Studio(studio::Args),
 }
 
 /// Runs the command line; returns the process exit code (0 success, 1 check failed or error,
@@ -47,6 +50,7 @@ pub fn main() -> ExitCode {
         Command::Export(a) => export::run(a),
         Command::Events(a) => events::run(a),
         Command::Generate(a) => generate::run(a),
+        Command::Studio(a) => studio::run(a),
     };
     match result {
         Ok(code) => code,

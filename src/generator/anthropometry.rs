@@ -244,6 +244,11 @@ pub struct Anthropometry {
     pub trunk_mass_kg: f64,
 }
 
+/// Body heights [`Anthropometry::from_height`] accepts, m (a standing human).
+pub const HEIGHT_RANGE_M: (f64, f64) = (0.8, 2.6);
+/// Body masses [`Anthropometry::from_height`] accepts, kg (a human).
+pub const MASS_RANGE_KG: (f64, f64) = (10.0, 300.0);
+
 impl Anthropometry {
     /// The figure of body height `height_m` (m) and mass `mass_kg` (kg) with every value taken
     /// from the tables (see the module docs), validated.
@@ -263,11 +268,17 @@ impl Anthropometry {
         check_range(
             "height_m",
             height_m,
-            0.8,
-            2.6,
+            HEIGHT_RANGE_M.0,
+            HEIGHT_RANGE_M.1,
             "m: body height of a standing human",
         )?;
-        check_range("mass_kg", mass_kg, 10.0, 300.0, "kg: body mass of a human")?;
+        check_range(
+            "mass_kg",
+            mass_kg,
+            MASS_RANGE_KG.0,
+            MASS_RANGE_KG.1,
+            "kg: body mass of a human",
+        )?;
         let a = Self::from_height_unchecked(height_m, mass_kg);
         a.validate()?;
         Ok(a)

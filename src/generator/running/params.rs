@@ -137,8 +137,10 @@ impl RunParams {
 pub const SPEED_RANGE: (f64, f64) = (0.3, 12.0);
 /// Accepted body heights, m.
 pub const HEIGHT_RANGE: (f64, f64) = (0.5, 2.6);
-/// Step frequencies searched when H drives sf, steps/min.
-const SF_SEARCH: (f64, f64) = (60.0, 260.0);
+/// Step frequencies searched when H drives sf, steps/min (also the studio's slider range).
+pub const SF_SEARCH: (f64, f64) = (60.0, 260.0);
+/// Accepted expertise levels: −1 (poor) … 1 (skilled).
+pub const LEVEL_RANGE: (f64, f64) = (-1.0, 1.0);
 
 /// The figure and the relations a run is generated with.
 #[derive(Debug, Clone, PartialEq)]
@@ -580,7 +582,7 @@ fn check_height(h: f64) -> Result<(), GenerateError> {
 }
 
 fn check_level(level: f64) -> Result<(), GenerateError> {
-    if !(-1.0..=1.0).contains(&level) {
+    if !(LEVEL_RANGE.0..=LEVEL_RANGE.1).contains(&level) {
         return Err(param_err(
             "level",
             level,
