@@ -119,41 +119,44 @@ pub fn host_is_loopback(host: &str) -> bool {
         || name.parse::<IpAddr>().is_ok_and(|ip| ip.is_loopback())
 }
 
+/// Why a request must be refused, if it must: a peer that is not loopback, a `Host` that does
+/// not name loopback, or an `Origin` (when sent) that is not loopback.
+pub fn refusal(peer: IpAddr, host: Option<&str>, origin: Option<&str>) -> Option<String> {
+    if !peer.is_loopback() {
+        return Some(format!("peer {peer} is not loopback"));
+    }
+    let host = host.unwrap_or("");
+    if !host_is_loopback(host) {
+        return Some(format!("Host {host:?} is not a loopback name"));
+    }
+    if let Some(o) = origin {
+        let h = o
+            .strip_prefix("http://")
+            .or_else(|| o.strip_prefix("https://"))
+            .unwrap_or("");
+        if !host_is_loopback(h) {
+            return Some(format!("Origin {o:?} is not this studio"));
+        }
+    }
+    None
+}
+
 /// Refuses every request that does not come from, and name, this machine's loopback.
 async fn guard(
     ConnectInfo(peer): ConnectInfo<SocketAddr>,
     request: Request,
     next: Next,
 ) -> Response {
-    let refuse = |why: &str| {
-        (
+    let headers = request.headers();
+    let text = |h: header::HeaderName| headers.get(h).map(|v| v.to_str().unwrap_or("\u{fffd}"));
+    match refusal(peer.ip(), text(header::HOST), text(header::ORIGIN)) {
+        Some(why) => (
             StatusCode::FORBIDDEN,
             format!("gaitfit studio serves this machine only (127.0.0.1): {why}\n"),
         )
-            .into_response()
-    };
-    if !peer.ip().is_loopback() {
-        return refuse(&format!("peer {} is not loopback", peer.ip()));
+            .into_response(),
+        None => next.run(request).await,
     }
-    let headers = request.headers();
-    let host = headers
-        .get(header::HOST)
-        .and_then(|h| h.to_str().ok())
-        .unwrap_or("");
-    if !host_is_loopback(host) {
-        return refuse(&format!("Host {host:?} is not a loopback name"));
-    }
-    if let Some(origin) = headers.get(header::ORIGIN) {
-        let o = origin.to_str().unwrap_or("");
-        let h = o
-            .strip_prefix("http://")
-            .or_else(|| o.strip_prefix("https://"))
-            .unwrap_or("");
-        if !host_is_loopback(h) {
-            return refuse(&format!("Origin {o:?} is not this studio"));
-        }
-    }
-    next.run(request).await
 }
 
 fn asset(content_type: &'static str, body: &'static str) -> Response {
@@ -260,6 +263,33 @@ fn panic_response(e: tokio::task::JoinError) -> Response {
         .into_response()
 }
 
+/// The answer to `/api/generate` (serialized straight from these types: the frames are most
+/// of it).
+#[derive(Serialize)]
+struct GenerateAnswer<'a> {
+    ok: bool,
+    generator: super::session::GeneratorKind,
+    controls: &'a [super::controls::Control],
+    locks: &'a [String],
+    flight_from_height: bool,
+    relations: super::session::RelationsChoice,
+    relations_source: &'a str,
+    notes: &'a [String],
+    figure: super::figure::FigureJson,
+    steps: Vec<StepView>,
+    plots: Vec<super::plots::Plot>,
+    timing: Timing,
+}
+
+/// Server-side times of one answer, ms (shown on the page).
+#[derive(Serialize)]
+struct Timing {
+    /// Resolving the parameters and generating the motion.
+    generate_ms: f64,
+    /// Everything before encoding the answer (generation, figure, plots).
+    server_ms: f64,
+}
+
 fn generate_json(body: &[u8], s: &AppState) -> Result<Vec<u8>, StudioError> {
     let t0 = Instant::now();
     let req = parse_request(body)?;
@@ -283,21 +313,27 @@ fn generate_json(body: &[u8], s: &AppState) -> Result<Vec<u8>, StudioError> {
             double_support_pct_cycle: r.double_support_pct_cycle,
         })
         .collect();
-    let value = json!({
-        "ok": true,
-        "generator": g.generator,
-        "controls": g.controls,
-        "locks": g.locks,
-        "flight_from_height": g.flight_from_height,
-        "relations": g.relations,
-        "relations_source": g.relations_source,
-        "notes": g.notes,
-        "figure": figure_json(&g.motion),
-        "steps": steps,
-        "plots": plots(&g, &s.sources.fits),
-        "timing": {"generate_ms": generate_ms, "server_ms": t0.elapsed().as_secs_f64() * 1e3},
-    });
-    serde_json::to_vec(&value).map_err(|e| StudioError::Server(format!("encoding the answer: {e}")))
+    let figure = figure_json(&g.motion);
+    let plots = plots(&g, &s.sources.fits);
+    let answer = GenerateAnswer {
+        ok: true,
+        generator: g.generator,
+        controls: &g.controls,
+        locks: &g.locks,
+        flight_from_height: g.flight_from_height,
+        relations: g.relations,
+        relations_source: &g.relations_source,
+        notes: &g.notes,
+        figure,
+        steps,
+        plots,
+        timing: Timing {
+            generate_ms,
+            server_ms: t0.elapsed().as_secs_f64() * 1e3,
+        },
+    };
+    serde_json::to_vec(&answer)
+        .map_err(|e| StudioError::Server(format!("encoding the answer: {e}")))
 }
 
 async fn generate_handler(State(s): State<Arc<AppState>>, body: Bytes) -> Response {
@@ -362,5 +398,24 @@ mod tests {
         ] {
             assert!(!host_is_loopback(h), "{h}");
         }
+    }
+
+    #[test]
+    fn only_loopback_peers_hosts_and_origins_pass() {
+        let lo: IpAddr = "127.0.0.1".parse().unwrap();
+        let h = Some("127.0.0.1:8765");
+        assert_eq!(refusal(lo, h, None), None);
+        assert_eq!(refusal(lo, h, Some("http://127.0.0.1:8765")), None);
+        assert_eq!(
+            refusal("::1".parse().unwrap(), Some("[::1]:8765"), None),
+            None
+        );
+        let lan: IpAddr = "192.168.1.20".parse().unwrap();
+        assert!(refusal(lan, h, None).unwrap().contains("not loopback"));
+        assert!(refusal("10.0.0.1".parse().unwrap(), h, None).is_some());
+        assert!(refusal(lo, Some("rebound.example:8765"), None).is_some());
+        assert!(refusal(lo, None, None).is_some());
+        assert!(refusal(lo, h, Some("http://evil.example")).is_some());
+        assert!(refusal(lo, h, Some("null")).is_some());
     }
 }

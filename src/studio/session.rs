@@ -146,6 +146,9 @@ fn default_seconds() -> f64 {
 /// Longest motion the studio generates, s (a design limit: the page holds every frame).
 pub const MAX_SECONDS: f64 = 120.0;
 
+/// Frame rates the studio generates at, frames/s (a design limit: every frame goes to the page).
+pub const FPS_RANGE: (f64, f64) = (10.0, 480.0);
+
 /// Where the studio finds refitted relations.
 #[derive(Debug, Clone)]
 pub struct Sources {
@@ -210,6 +213,14 @@ pub fn generate(req: &StudioRequest, src: &Sources) -> Result<Generated, StudioE
             "duration {} s: must be within (0, {MAX_SECONDS}] s",
             req.seconds
         )));
+    }
+    if let Some(fps) = req.fps {
+        if !(fps.is_finite() && (FPS_RANGE.0..=FPS_RANGE.1).contains(&fps)) {
+            return Err(StudioError::Request(format!(
+                "frame rate {fps}: must be within [{}, {}] frames/s",
+                FPS_RANGE.0, FPS_RANGE.1
+            )));
+        }
     }
     match req.generator {
         GeneratorKind::Run => run(req, src),
@@ -859,10 +870,12 @@ fn generalize_plan(
                 (None, Some(sl), Some(sf)) => (sl, sf),
                 (None, Some(sl), None) => (sl, cur.1),
                 (None, None, Some(sf)) => (cur.0, sf),
-                (None, None, None) => return Err(StudioError::Request(format!(
+                (None, None, None) => {
+                    return Err(StudioError::Request(format!(
                     "schedule row {}: give a speed, a step length or a step frequency (or stop)",
                     next + 1
-                ))),
+                )))
+                }
             };
             check_locomotion(cur.0, cur.1, h)
                 .map_err(|e| StudioError::Request(format!("schedule row {}: {e}", next + 1)))?;
