@@ -28,6 +28,10 @@
   // ---------------------------------------------------------------- requests
   function body(edit) {
     const v = Object.assign({}, values);
+    if (edit && edit.key === 'height_m' && good) {
+      // Attributes left at their defaults take the new body's defaults (lengths scale with it).
+      for (const c of good.controls) if (c.group === 'attribute' && c.value === c.default) delete v[c.key];
+    }
     if (edit && edit.key) v[edit.key] = edit.value;
     return {
       generator,
