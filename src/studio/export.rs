@@ -91,7 +91,7 @@ pub fn export(g: &Generated, format: &str) -> Result<Download, StudioError> {
     };
     let path = dir.path().join(&filename);
     if format == "steps" {
-        crate::ingest::trials::write_trials(&path, &g.steps)?;
+        crate::ingest::trials::write_trials(&path, &g.steps).map_err(crate::Error::from)?;
     } else {
         crate::export::motion::write(&g.motion, &path)?;
     }
