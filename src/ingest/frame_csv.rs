@@ -26,7 +26,7 @@
 //!   `right…` (`l…`/`left…`) carries that foot only. Force cells must be finite.
 //! - Contact columns `l_contact`, `r_contact` (0/1, as gaitfit's generators write them): the
 //!   writer's own contact state of that foot. They become reference events of source
-//!   [`EventSource::Generated`](crate::gait::EventSource::Generated) (a heel strike where a foot's flag turns 1, a toe off where it
+//!   [`EventSource::Generated`] (a heel strike where a foot's flag turns 1, a toe off where it
 //!   turns 0, at the first frame of the new state): kept for comparison, never used in place of
 //!   detection (the point of reading a generated motion back is to measure it).
 //! - Angle columns `<name>_x_deg`, `<name>_y_deg`, `<name>_z_deg` (or `_rad`), e.g. the

@@ -2,7 +2,7 @@
 //!
 //! Generation is CPU work and runs on tokio's blocking pool, one request at a time per
 //! connection; a panic there (a bug) becomes a 500 answer with the message, never a dead
-//! server. Every request passes [`guard`] first: the peer must be a loopback address, the
+//! server. Every request passes the guard ([`refusal`]) first: the peer must be a loopback address, the
 //! `Host` header must name a loopback host (a page elsewhere cannot reach the studio by
 //! rebinding a DNS name to 127.0.0.1), and an `Origin`, when sent, must be loopback too.
 //!
