@@ -468,7 +468,7 @@
       const note = document.createElement('p');
       note.className = 'plot-note';
       const d = dataPoints[p.id];
-      note.textContent = p.note + (d ? ' · data: ' + d.source + ' (each subject at their own height)' : '');
+      note.textContent = p.note + (d ? ' · points: ' + d.source + ' (each subject at their own height)' : '');
       box.appendChild(note);
       drawPlot(c, p, d ? d.points : []);
     }
