@@ -222,6 +222,16 @@ fn shown(cdp: &mut Cdp, key: &str) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
 
+/// Types `value` into a control's number box (a `change` event) and waits for the answer.
+fn set_number(cdp: &mut Cdp, key: &str, value: f64) {
+    let s = seq(cdp);
+    cdp.eval(&format!(
+        "(() => {{ const n = document.querySelector('.ctl[data-key=\"{key}\"] \
+         input[type=number]'); n.value = '{value}'; n.dispatchEvent(new Event('change')); }})()"
+    ));
+    cdp.settle(s);
+}
+
 fn seq(cdp: &mut Cdp) -> u64 {
     let v = cdp.eval("window.studio.seq + window.studio.errors");
     v.as_u64().unwrap_or(0)
@@ -342,6 +352,25 @@ fn studio_in_chromium() {
         "error shown: {err:?}"
     );
 
+    // RUNNER's locks (§3.1.1), clicked on the page: speed locked at 12 km/h, step frequency
+    // raised 187 → 210 steps/min: the step length falls from 1.07 to 0.95 m.
+    set_number(&mut cdp, "speed_km_per_h", 12.0);
+    assert!(
+        (shown(&mut cdp, "step_length_m") - 1.069).abs() < 0.002,
+        "natural at 12 km/h"
+    );
+    cdp.eval("document.querySelector('.ctl[data-key=\"speed_km_per_h\"] input.lock').click()");
+    set_number(&mut cdp, "step_freq_steps_per_min", 210.0);
+    let (v, sl) = (
+        shown(&mut cdp, "speed_km_per_h"),
+        shown(&mut cdp, "step_length_m"),
+    );
+    assert!(
+        (v - 12.0).abs() < 1e-9 && (sl - 0.95).abs() < 0.005,
+        "locked v: {v} km/h, sl {sl} m"
+    );
+    cdp.eval("document.querySelector('.ctl[data-key=\"speed_km_per_h\"] input.lock').click()");
+
     // A walk above the walk–run transition: the generator's note is on the page.
     let s = seq(&mut cdp);
     cdp.eval("window.studio.setGenerator('walk')");
@@ -378,6 +407,26 @@ fn studio_in_chromium() {
         "eq. 1 lengthens the walking step with speed: {wsl0} → {wsl1}"
     );
     report("walk, 10 s at 100 frames/s", &latencies(&mut cdp, 7));
+
+    // A schedule row added on the page: from step 4 on, 6.5 km/h (ramped as KLAW ramps).
+    let s = seq(&mut cdp);
+    cdp.eval("document.getElementById('add-row').click()");
+    cdp.settle(s);
+    let s = seq(&mut cdp);
+    cdp.eval(
+        "(() => { const i = document.querySelector('#schedule tbody tr input[name=\"speed_km_per_h\"]'); \
+         i.value = '6.5'; i.dispatchEvent(new Event('change')); })()",
+    );
+    cdp.settle(s);
+    let last = cdp.eval(
+        "(() => { const r = document.getElementById('steps').rows; \
+         return r[r.length - 1].cells[3].textContent; })()",
+    );
+    assert_eq!(
+        last,
+        json!("6.50"),
+        "the last step walks at the scheduled speed"
+    );
     assert_eq!(cdp.console_errors, Vec::<String>::new(), "console errors");
 
     // Export: the TRC download is read back by `gaitfit events`.
