@@ -22,6 +22,7 @@
   let locks = new Set();
   let flightFromHeight = false;
   let dataPoints = {};
+  let dataNotes = [];       // data tables that could not be read (said once per answer)
   const queue = [];         // pending edits: {key, value}
   let busy = false;
 
@@ -226,7 +227,7 @@
   function renderNotes(notes) {
     const el = $('notes');
     el.textContent = '';
-    for (const n of notes) {
+    for (const n of notes.concat(dataNotes)) {
       const d = document.createElement('div');
       d.textContent = 'note: ' + n;
       el.appendChild(d);
@@ -576,6 +577,7 @@
       catalog = await (await fetch('/api/catalog')).json();
       const d = await (await fetch('/api/data')).json();
       dataPoints = d.relations || {};
+      dataNotes = d.notes || [];
     } catch (err) {
       showError('The studio server did not answer: ' + err.message);
       return;

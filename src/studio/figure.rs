@@ -51,7 +51,7 @@ pub struct EventJson {
 /// The figure's frames.
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct FigureJson {
-    /// Frames per second.
+    /// Frames per second of the frames sent.
     pub fps: f64,
     /// Number of frames.
     pub frames: usize,
@@ -73,21 +73,28 @@ fn round(x: f64) -> f64 {
     (x / ROUND_M).round() * ROUND_M
 }
 
-/// The page's view of `motion`.
+/// Frames per second sent to the page at most: a screen refreshes about this often, so more
+/// frames would only lengthen the answer (the exports carry every frame of the motion).
+pub const DISPLAY_FPS: f64 = 60.0;
+
+/// The page's view of `motion`: every k-th frame, k the smallest whole number that brings the
+/// rate to [`DISPLAY_FPS`] or below; events keep their exact times.
 pub fn figure_json(motion: &Motion) -> FigureJson {
-    let n = motion.len();
+    let stride = ((motion.fps() / DISPLAY_FPS).ceil() as usize).max(1);
+    let frames: Vec<usize> = (0..motion.len()).step_by(stride).collect();
+    let n = frames.len();
+    let all = motion.all_landmarks();
     let mut xyz = Vec::with_capacity(n * Landmark::ALL.len() * 3);
-    for f in motion.all_landmarks() {
-        for p in f.iter() {
+    let mut contacts = Vec::with_capacity(2 * n);
+    for &i in &frames {
+        for p in all[i].iter() {
             xyz.extend([round(p.x), round(p.y), round(p.z)]);
         }
-    }
-    let mut contacts = Vec::with_capacity(2 * n);
-    for c in motion.contacts() {
+        let c = motion.contacts()[i];
         contacts.extend([u8::from(c[0]), u8::from(c[1])]);
     }
     FigureJson {
-        fps: motion.fps(),
+        fps: motion.fps() / stride as f64,
         frames: n,
         landmarks: Landmark::ALL.iter().map(|l| l.name()).collect(),
         bones: BONES.iter().map(|(a, b)| [a.index(), b.index()]).collect(),
@@ -109,5 +116,28 @@ pub fn figure_json(motion: &Motion) -> FigureJson {
                 kind: e.kind.as_str().to_string(),
             })
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generator::motion::MotionMetadata;
+    use crate::generator::skeleton::Skeleton;
+
+    #[test]
+    fn frames_are_thinned_to_the_display_rate() {
+        let sk = Skeleton::from_height(1.8, 75.0).unwrap();
+        let mut m = Motion::new(sk.clone(), 120.0, MotionMetadata::default()).unwrap();
+        for i in 0..241 {
+            m.push_frame(sk.rest_pose(), [i % 2 == 0, true]);
+        }
+        let f = figure_json(&m);
+        assert_eq!((f.frames, f.fps), (121, 60.0));
+        assert_eq!(f.xyz.len(), 121 * Landmark::ALL.len() * 3);
+        assert_eq!(&f.contacts[..4], &[1, 1, 1, 1]);
+        let mut m = Motion::new(sk.clone(), 50.0, MotionMetadata::default()).unwrap();
+        m.push_frame(sk.rest_pose(), [true, true]);
+        assert_eq!(figure_json(&m).fps, 50.0);
     }
 }
