@@ -133,7 +133,7 @@
       row.dataset.key = c.key;
       const label = document.createElement('label');
       label.textContent = c.label;
-      label.title = c.doc;
+      label.title = c.label + ' (' + c.unit + '): ' + c.doc;
       row.appendChild(label);
       let input;
       if (c.choices.length) {
@@ -218,6 +218,7 @@
     document.querySelectorAll('input.invalid').forEach((x) => x.classList.remove('invalid'));
     renderValues();
     clearError();
+    $('relations-source').textContent = json.relations_source;
     renderNotes(json.notes);
     renderSteps(json.steps);
     setFigure(json.figure);

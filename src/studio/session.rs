@@ -343,7 +343,10 @@ fn run(req: &StudioRequest, src: &Sources) -> Result<Generated, StudioError> {
         flight_from_height: params.flight_from_height,
         notes,
         relations: req.relations,
-        relations_source: relations.source.clone(),
+        relations_source: match req.relations {
+            RelationsChoice::Published => "published (running paper, eqs. 2, 4–5)".into(),
+            RelationsChoice::Refit => format!("refit: {}", relations.source),
+        },
         run_relations: Some(relations),
         walk_relations: None,
     })
@@ -586,7 +589,12 @@ fn walk(req: &StudioRequest, src: &Sources) -> Result<Generated, StudioError> {
         flight_from_height: false,
         notes: report.notes,
         relations: req.relations,
-        relations_source: relations_name(req).into(),
+        relations_source: match req.relations {
+            RelationsChoice::Published => {
+                "published (walking paper: k = 0.004, d0 = 29.08, d1 = −0.16)".into()
+            }
+            RelationsChoice::Refit => format!("refit: {}", src.fits.display()),
+        },
         run_relations: None,
         walk_relations: Some(relations),
     })
