@@ -429,30 +429,58 @@ fn studio_in_chromium() {
     );
     assert_eq!(cdp.console_errors, Vec::<String>::new(), "console errors");
 
-    // Export: the TRC download is read back by `gaitfit events`.
-    cdp.eval("document.querySelector('#exports button[data-format=\"trc\"]').click()");
-    let file = downloads.join("gaitfit-walk.trc");
-    let t0 = Instant::now();
-    while !file.exists() {
-        assert!(t0.elapsed() < PATIENCE, "no download at {}", file.display());
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    // The download is renamed into place when complete; give the rename a moment to land.
-    std::thread::sleep(Duration::from_millis(200));
-    let out = Command::new(env!("CARGO_BIN_EXE_gaitfit"))
-        .arg("events")
-        .arg(&file)
-        .output()
-        .expect("run gaitfit events");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "gaitfit events {}: {}",
-        file.display(),
-        String::from_utf8_lossy(&out.stderr)
+    // Export: the TRC and CSV downloads are read back by `gaitfit events`, which finds the
+    // walk's steps with the page's step lengths (its table's range, ±2 %).
+    let lengths = cdp.eval(
+        "Array.from(document.getElementById('steps').rows).slice(1).map(r => Number(r.cells[4].textContent))",
     );
-    let rows: Vec<&str> = stdout.lines().skip(1).collect();
-    assert!(rows.len() >= 6, "steps found in the export: {stdout}");
-    assert!(rows.iter().all(|r| r.contains(",walk,")), "{stdout}");
+    let lengths: Vec<f64> = lengths
+        .as_array()
+        .map(|a| a.iter().filter_map(Value::as_f64).collect())
+        .unwrap_or_default();
+    let lo = lengths.iter().copied().fold(f64::INFINITY, f64::min) * 0.98;
+    let hi = lengths.iter().copied().fold(0.0, f64::max) * 1.02;
+    for format in ["trc", "csv"] {
+        cdp.eval(&format!(
+            "document.querySelector('#exports button[data-format=\"{format}\"]').click()"
+        ));
+        let file = downloads.join(format!("gaitfit-walk.{format}"));
+        let t0 = Instant::now();
+        while !file.exists() {
+            assert!(t0.elapsed() < PATIENCE, "no download at {}", file.display());
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        // The download is renamed into place when complete; give the rename a moment to land.
+        std::thread::sleep(Duration::from_millis(200));
+        let out = Command::new(env!("CARGO_BIN_EXE_gaitfit"))
+            .arg("events")
+            .arg(&file)
+            .output()
+            .expect("run gaitfit events");
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "gaitfit events {}: {}",
+            file.display(),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let rows: Vec<&str> = stdout.lines().skip(1).collect();
+        assert!(
+            rows.len() >= 6,
+            "steps found in the {format} export: {stdout}"
+        );
+        for r in &rows {
+            let cells: Vec<&str> = r.split(',').collect();
+            assert_eq!(cells.get(1), Some(&"walk"), "{r}");
+            let sl: f64 = cells
+                .get(7)
+                .and_then(|c| c.parse().ok())
+                .unwrap_or(f64::NAN);
+            assert!(
+                sl >= lo && sl <= hi,
+                "{format}: detected step length {sl} m outside the page's [{lo}, {hi}] m: {r}"
+            );
+        }
+    }
     assert_eq!(cdp.console_errors, Vec::<String>::new(), "console errors");
 }
