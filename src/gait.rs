@@ -135,6 +135,29 @@ pub enum EventSource {
     Generated,
 }
 
+impl EventSource {
+    /// The name used in tables and on the command line (`force`, `zeni_coordinate`,
+    /// `foot_height`, …): the `event_source` of the steps table and the `method` of the events
+    /// table.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            EventSource::Force => "force",
+            EventSource::ZeniCoordinate => "zeni_coordinate",
+            EventSource::ZeniVelocity => "zeni_velocity",
+            EventSource::FootMarkers => "foot_height",
+            EventSource::FootSpeed => "foot_speed",
+            EventSource::Reference => "reference",
+            EventSource::Generated => "generated",
+        }
+    }
+}
+
+impl fmt::Display for EventSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// One gait event of one foot.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct GaitEvent {

@@ -66,7 +66,7 @@ fn writes_steps_comparison_and_plots_from_a_folder() {
 }
 
 #[test]
-fn a_failing_trial_writes_nothing() {
+fn a_failing_trial_is_named_and_the_others_are_written() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("trials");
     std::fs::create_dir(&data).unwrap();
@@ -84,16 +84,44 @@ fn a_failing_trial_writes_nothing() {
     let assert = Command::cargo_bin("gaitfit")
         .unwrap()
         .current_dir(dir.path())
-        .args(["events", "trials", "-o", "steps.csv", "--belt-speed", "1.3"])
+        .args([
+            "events",
+            "trials",
+            "-o",
+            "steps.csv",
+            "--events-out",
+            "events.csv",
+            "--belt-speed",
+            "1.3",
+        ])
         .assert()
-        .failure();
+        .code(1);
     let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
     assert!(
         err.contains("standing_grf.mot") || err.contains("standing.trc"),
         "{err}"
     );
+    assert!(err.contains("1 of 2 trial(s) failed"), "{err}");
+    // The good trial's outputs are there, and only its rows.
+    let steps = std::fs::read_to_string(dir.path().join("steps.csv")).unwrap();
+    assert!(steps.lines().count() > 2, "{steps}");
+    assert!(steps.lines().skip(1).all(|l| l.contains("walk")), "{steps}");
+    assert!(!steps.contains("standing"), "{steps}");
+    let events = std::fs::read_to_string(dir.path().join("events.csv")).unwrap();
+    assert!(events.starts_with("subject,trial,time_s,side,event,method,source\n"));
+    assert!(events.contains(",heel_strike,force,") && events.contains(",toe_off,force,"));
+    // All of them failing: nothing to write, and the message says so.
+    std::fs::remove_file(data.join("walk.trc")).unwrap();
+    std::fs::remove_file(data.join("walk_grf.mot")).unwrap();
+    let assert = Command::cargo_bin("gaitfit")
+        .unwrap()
+        .current_dir(dir.path())
+        .args(["events", "trials", "-o", "again.csv", "--belt-speed", "1.3"])
+        .assert()
+        .code(1);
+    let err = String::from_utf8_lossy(&assert.get_output().stderr).to_string();
     assert!(err.contains("nothing was written"), "{err}");
-    assert!(!dir.path().join("steps.csv").exists());
+    assert!(!dir.path().join("again.csv").exists());
 }
 
 #[test]

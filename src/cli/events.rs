@@ -15,9 +15,9 @@ use std::process::ExitCode;
     after_help = "Inputs: .trc (with X.forces or X_grf.mot beside it), .mot/.sto GRF, \
     .forces, .c3d, WBDS *grf.txt, Winter's table; folders are searched recursively (static \
     trials and companion files skipped); MARKERS+FORCES pairs a marker file with a force file \
-    of another name (e.g. motion_capture_run.trc+grf_run.mot).\n\nDefaults: force 20 Hz \
-    low-pass, contact on above 50 N and off below 20 N (events timed at 20 N); markers 6 Hz \
-    low-pass; Zeni extrema hysteresis 30 % of the signal range; matching tolerance 60 ms."
+    of another name (e.g. motion_capture_run.trc+grf_run.mot).\n\nDefaults: contacts found \
+    on the force low-passed at 20 Hz (on at 50 N, off at 20 N), events timed where the \
+    unfiltered force crosses 20 N; markers 6 Hz low-pass; Zeni extrema hysteresis 30 % of the signal range; matching tolerance 60 ms."
 )]
 pub struct Args {
     /// Trial files or folders.
@@ -27,6 +27,10 @@ pub struct Args {
     /// unless --compare or --summary is given.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<std::path::PathBuf>,
+    /// Write one row per event here (CSV: subject, trial, time_s, side, event, method,
+    /// source): the heel strikes and toe offs the steps are built from, and the foot phases.
+    #[arg(long, value_name = "FILE")]
+    pub events_out: Option<std::path::PathBuf>,
     /// Compare the kinematic methods with the force-plate events (`force`) or with the
     /// file's reference events (`reference`): detection F1 and timing error per event type.
     #[arg(long, value_name = "force|reference")]
@@ -60,13 +64,19 @@ pub struct Args {
     /// Treadmill belt speed, m/s (default: from the file or its metadata).
     #[arg(long, value_name = "M_PER_S")]
     pub belt_speed: Option<f64>,
-    /// Force low-pass cutoff, Hz.
+    /// Force low-pass cutoff for finding the contacts, Hz.
     #[arg(long, default_value_t = 20.0)]
     pub force_cutoff: f64,
-    /// Contact-on threshold, N.
+    /// Low-pass cutoff of the force the events are timed on, Hz (default: the unfiltered
+    /// force; at least --force-cutoff).
+    #[arg(long, value_name = "HZ")]
+    pub force_timing_cutoff: Option<f64>,
+    /// Contact-on threshold, N: a contact must reach it (equal to --off for a single
+    /// threshold).
     #[arg(long, default_value_t = 50.0)]
     pub on: f64,
-    /// Contact-off threshold, N.
+    /// Contact-off threshold, N: contacts begin and end where the force crosses it, and the
+    /// events are timed there on the unfiltered force.
     #[arg(long, default_value_t = 20.0)]
     pub off: f64,
     /// Subtract a linear baseline from drifting force plates instead of failing.
@@ -114,6 +124,7 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
         opts.markers = Some(m);
     }
     opts.force.cutoff_hz = args.force_cutoff;
+    opts.force.timing_cutoff_hz = args.force_timing_cutoff;
     opts.force.on_n = args.on;
     opts.force.off_n = args.off;
     opts.force.correct_drift = args.correct_drift;
@@ -123,6 +134,7 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
 
 struct TrialResult {
     table: StepTable,
+    events: Vec<crate::events::per_event::EventRow>,
     compare: CompareTable,
     notes: Vec<String>,
     label: String,
@@ -138,6 +150,7 @@ fn process(
     let trial = read_input(input, read)?;
     let an = analyse(&trial, opts)?;
     let table = steps_from_analysis(&trial, &an, opts)?;
+    let events = crate::events::per_event::event_rows(&trial, &an);
     let compare = match compare_with {
         Some(src) => an.compare(src, args.tolerance_ms / 1000.0),
         None => CompareTable::default(),
@@ -167,6 +180,7 @@ fn process(
     notes.extend(table.notes.iter().cloned());
     Ok(TrialResult {
         table,
+        events,
         compare,
         notes,
         label: input.label(),
@@ -271,7 +285,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         })
         .collect();
     bar.finish_and_clear();
-    // No partial output: any failed trial fails the command before anything is written.
+    // A bad file does not cost the others: the good trials' outputs are written, every failure
+    // is named, and the exit status says that something failed.
     let mut ok = Vec::new();
     let mut errors = Vec::new();
     for r in results {
@@ -280,11 +295,10 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             Err(e) => errors.push(format!("{e:#}")),
         }
     }
-    if !errors.is_empty() {
+    if ok.is_empty() {
         anyhow::bail!(
-            "{} of {} trial(s) failed; nothing was written:\n  {}",
+            "all {} trial(s) failed; nothing was written:\n  {}",
             errors.len(),
-            inputs.len(),
             errors.join("\n  ")
         );
     }
@@ -306,6 +320,17 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         }
         None => {}
     }
+    if let Some(path) = &args.events_out {
+        let rows: Vec<crate::events::per_event::EventRow> =
+            ok.iter().flat_map(|r| r.events.iter().cloned()).collect();
+        crate::events::per_event::write_csv(path, &rows)?;
+        eprintln!(
+            "gaitfit events: {} events from {} trial(s) → {}",
+            rows.len(),
+            ok.len(),
+            path.display()
+        );
+    }
     if args.summary {
         print!("{}", summary(&ok));
     }
@@ -326,6 +351,16 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         } else {
             print!("{}", all.render());
         }
+    }
+    if !errors.is_empty() {
+        eprintln!(
+            "gaitfit events: {} of {} trial(s) failed (the outputs above hold the other {}):\n  {}",
+            errors.len(),
+            inputs.len(),
+            ok.len(),
+            errors.join("\n  ")
+        );
+        return Ok(ExitCode::FAILURE);
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -1,12 +1,24 @@
 //! Heel strike and toe off from the vertical ground reaction force.
 //!
-//! Per plate: the vertical force is low-pass filtered (zero-phase Butterworth, default order 2 at
-//! 20 Hz), its unloaded baseline is measured on the unloaded samples and removed (an offset is
-//! noted; a drift above the tolerance is an error unless drift correction is asked for), then a
-//! threshold with hysteresis finds the contacts: a contact starts when the force exceeds
-//! `on_n` (default 50 N) and ends when it falls below `off_n` (default 20 N). Both events are
-//! timed where the force crosses `off_n` (linear interpolation between samples): the higher
-//! level only confirms that a real contact, not noise, began.
+//! Two steps, each on the signal that suits it:
+//!
+//! 1. **Finding the contacts** (robust): per plate, the vertical force is low-pass filtered
+//!    (zero-phase Butterworth, default order 2 at 20 Hz), its unloaded baseline is measured on
+//!    the unloaded samples and removed (an offset is noted; a drift above the tolerance is an
+//!    error unless drift correction is asked for), then a threshold with hysteresis finds the
+//!    contacts: a contact is a run of the filtered force at or above `off_n` (default 20 N) that
+//!    reaches `on_n` (default 50 N; `on_n = off_n` is a single threshold). Short dips are
+//!    merged, short blips dropped.
+//! 2. **Timing the events** (unbiased): the filter smears every edge (a 20 Hz filter spreads
+//!    a step over about ±25 ms, so the filtered force crosses 20 N before the force does at
+//!    heel strike and after it at toe off), so each event is timed on the *unfiltered*
+//!    baseline-corrected force (or on the force low-passed at `timing_cutoff_hz`, when given),
+//!    where it crosses `off_n`, interpolated linearly between samples. The crossing is searched
+//!    within one period of the detection cutoff (1/`cutoff_hz`, the farthest the filter moves
+//!    an edge) of the filtered contact's edge: heel strike at the first sample of the contact
+//!    at or above the level (extended backward while the force stays at or above it), toe off
+//!    after its last, so isolated dropout samples inside a contact (the WBDS export zeroes
+//!    some) do not cut it short.
 //!
 //! Plates that carry one known foot (dual-belt treadmill belts, OpenSim `R_`/`L_` forces) give
 //! that foot's events directly. Overground plates (`side: None`) are assigned to a foot by the
@@ -28,8 +40,14 @@ pub struct ForceOptions {
     pub order: usize,
     /// Contact-on threshold, N (default 50).
     pub on_n: f64,
-    /// Contact-off threshold, N (default 20); events are timed at this level.
+    /// Contact-off threshold, N (default 20); events are timed where the unfiltered force
+    /// crosses this level.
     pub off_n: f64,
+    /// Low-pass cutoff of the signal the events are timed on, Hz; `None` (the default) times
+    /// them on the unfiltered force. Set it (≥ 100 Hz keeps the edge bias near a millisecond)
+    /// for plates whose noise crosses the threshold outside contacts.
+    #[serde(default)]
+    pub timing_cutoff_hz: Option<f64>,
     /// Shortest contact kept, s (default 0.05): shorter ones are noise or a brush of the plate.
     pub min_contact_s: f64,
     /// Shortest unloaded gap between two contacts of one plate, s (default 0.05): shorter gaps
@@ -48,6 +66,7 @@ impl Default for ForceOptions {
             order: 2,
             on_n: 50.0,
             off_n: 20.0,
+            timing_cutoff_hz: None,
             min_contact_s: 0.05,
             min_gap_s: 0.05,
             drift_tolerance_n: 10.0,
@@ -88,7 +107,8 @@ pub struct Contact {
 pub struct PlateReport {
     /// Plate name.
     pub name: String,
-    /// Baseline removed (mean unloaded level), N.
+    /// Baseline removed (median unloaded level; with drift correction, the mean of the fitted
+    /// line), N.
     pub offset_n: f64,
     /// Baseline drift over the trial (end − start of the fitted line), N.
     pub drift_n: f64,
@@ -146,14 +166,16 @@ fn percentile(v: &mut [f64], p: f64) -> f64 {
     *v.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
-/// Filters the vertical force of `plate` and removes its unloaded baseline.
+/// The vertical force of `plate`, filtered for finding contacts and unfiltered (or filtered at
+/// [`ForceOptions::timing_cutoff_hz`]) for timing them, both with the unloaded baseline
+/// removed: `(filtered, timing, report)`.
 pub fn vertical_force(
     plate: &ForcePlate,
     axis: usize,
     path: &str,
     opts: &ForceOptions,
     notes: &mut Vec<String>,
-) -> Result<(Vec<f64>, PlateReport), EventError> {
+) -> Result<(Vec<f64>, Vec<f64>, PlateReport), EventError> {
     let raw: Vec<f64> = plate.force_n.iter().map(|f| f[axis]).collect();
     let n = raw.len();
     let plate_err = |message: String| EventError::Plate {
@@ -176,6 +198,10 @@ pub fn vertical_force(
         });
     }
     let mut f = filtfilt_gappy(&filter, &raw);
+    let mut g = match opts.timing_cutoff_hz {
+        None => raw,
+        Some(c) => filtfilt_gappy(&Butterworth::low_pass(opts.order, c, plate.rate_hz)?, &raw),
+    };
     let mut finite: Vec<f64> = f.iter().copied().filter(|v| v.is_finite()).collect();
     let (p2, p98) = (percentile(&mut finite, 0.02), percentile(&mut finite, 0.98));
     let mut report = PlateReport {
@@ -185,7 +211,7 @@ pub fn vertical_force(
         contacts: 0,
     };
     if finite.is_empty() {
-        return Ok((f, report));
+        return Ok((f, g, report));
     }
     if p98 < opts.on_n && p2 < -opts.on_n {
         return Err(plate_err(format!(
@@ -195,7 +221,7 @@ pub fn vertical_force(
     }
     if p98 < opts.on_n {
         // Never loaded: nobody stepped on this plate.
-        return Ok((f, report));
+        return Ok((f, g, report));
     }
     if p2 > 0.25 * p98 {
         return Err(plate_err(format!(
@@ -234,8 +260,9 @@ pub fn vertical_force(
                     tolerance_n: opts.drift_tolerance_n,
                 });
             }
-            for (v, &ti) in f.iter_mut().zip(&plate.time_s) {
+            for ((v, w), &ti) in f.iter_mut().zip(g.iter_mut()).zip(&plate.time_s) {
                 *v -= ym + slope * (ti - tm);
+                *w -= ym + slope * (ti - tm);
             }
             notes.push(format!(
                 "force plate {}: baseline drift of {:.1} N over the trial subtracted (linear fit \
@@ -245,13 +272,27 @@ pub fn vertical_force(
                 unloaded.len()
             ));
         } else {
-            for v in f.iter_mut() {
-                *v -= ym;
+            // The median of the unfiltered unloaded samples: spikes of the unloaded signal
+            // (WBDS has isolated −20 to −30 N samples) would pull a mean, and the filter
+            // spreads them; the level the events are timed against is the typical one.
+            let mut u: Vec<f64> = unloaded
+                .iter()
+                .map(|&i| g[i])
+                .filter(|v| v.is_finite())
+                .collect();
+            let level = if u.is_empty() {
+                ym
+            } else {
+                percentile(&mut u, 0.5)
+            };
+            report.offset_n = level;
+            for v in f.iter_mut().chain(g.iter_mut()) {
+                *v -= level;
             }
-            if ym.abs() > 2.0 {
+            if level.abs() > 2.0 {
                 notes.push(format!(
-                    "force plate {}: unloaded offset of {ym:.1} N removed (mean of {} unloaded \
-                     samples); drift {:.1} N is within tolerance",
+                    "force plate {}: unloaded offset of {level:.1} N removed (median of {} \
+                     unloaded samples); drift {:.1} N is within tolerance",
                     plate.name,
                     unloaded.len(),
                     report.drift_n
@@ -259,57 +300,50 @@ pub fn vertical_force(
             }
         }
     }
-    Ok((f, report))
+    Ok((f, g, report))
 }
 
-/// Raw contacts (`(start index, end index, on time, off time)`) of one filtered force signal by
-/// threshold with hysteresis. `on`/`off` times are `None` when the record starts/ends loaded.
-fn threshold_contacts(
-    t: &[f64],
-    f: &[f64],
-    opts: &ForceOptions,
-) -> Vec<(usize, usize, Option<f64>, Option<f64>)> {
+/// One contact of one plate: first and last index of the filtered force at or above `off_n`,
+/// and the heel-strike and toe-off times (`None` when the record starts/ends loaded).
+type RawContact = (usize, usize, Option<f64>, Option<f64>);
+
+/// Time between samples `i` and `i + 1` where `x` crosses `level` (linear interpolation).
+fn crossing(t: &[f64], x: &[f64], i: usize, level: f64) -> f64 {
+    let (a, b) = (x[i], x[i + 1]);
+    if !(a.is_finite() && b.is_finite()) || (b - a).abs() < 1e-12 {
+        return if a.is_finite() { t[i] } else { t[i + 1] };
+    }
+    t[i] + ((level - a) / (b - a)).clamp(0.0, 1.0) * (t[i + 1] - t[i])
+}
+
+/// Contacts of one plate: found on the filtered force `f` by threshold with hysteresis, timed
+/// on `g` (see the module docs).
+fn threshold_contacts(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions) -> Vec<RawContact> {
     let n = f.len();
-    let cross = |i: usize, level: f64| -> f64 {
-        // Time between samples i and i+1 where the force crosses `level`.
-        let (a, b) = (f[i], f[i + 1]);
-        if (b - a).abs() < 1e-12 {
-            t[i]
-        } else {
-            t[i] + (level - a) / (b - a) * (t[i + 1] - t[i])
-        }
-    };
-    let mut out: Vec<(usize, usize, Option<f64>, Option<f64>)> = Vec::new();
+    let level = opts.off_n;
+    let mut out: Vec<RawContact> = Vec::new();
     let mut i = 0;
     while i < n {
-        if f[i].is_nan() || f[i] <= opts.on_n {
+        if f[i].is_nan() || f[i] < opts.on_n {
             i += 1;
             continue;
         }
         // Walk back to where the force last rose through off_n.
         let mut s = i;
-        while s > 0 && f[s - 1].is_finite() && f[s - 1] >= opts.off_n {
+        while s > 0 && f[s - 1].is_finite() && f[s - 1] >= level {
             s -= 1;
         }
-        let on = if s == 0 || !f[s - 1].is_finite() {
-            None
-        } else {
-            Some(cross(s - 1, opts.off_n))
-        };
+        let on = (s > 0 && f[s - 1].is_finite()).then(|| crossing(t, f, s - 1, level));
         let mut e = i;
-        while e + 1 < n && f[e + 1].is_finite() && f[e + 1] >= opts.off_n {
+        while e + 1 < n && f[e + 1].is_finite() && f[e + 1] >= level {
             e += 1;
         }
-        let off = if e + 1 >= n || !f[e + 1].is_finite() {
-            None
-        } else {
-            Some(cross(e, opts.off_n))
-        };
+        let off = (e + 1 < n && f[e + 1].is_finite()).then(|| crossing(t, f, e, level));
         out.push((s, e, on, off));
         i = e + 1;
     }
     // Merge contacts separated by a short gap; drop short ones (unless truncated by the record).
-    let mut merged: Vec<(usize, usize, Option<f64>, Option<f64>)> = Vec::new();
+    let mut merged: Vec<RawContact> = Vec::new();
     for c in out {
         if let Some(last) = merged.last_mut() {
             if t[c.0] - t[last.1] < opts.min_gap_s {
@@ -320,10 +354,70 @@ fn threshold_contacts(
         }
         merged.push(c);
     }
+    merged.retain(|c| c.2.is_none() || c.3.is_none() || t[c.1] - t[c.0] >= opts.min_contact_s);
+    retime(t, f, g, opts, &mut merged);
     merged
-        .into_iter()
-        .filter(|c| c.2.is_none() || c.3.is_none() || t[c.1] - t[c.0] >= opts.min_contact_s)
-        .collect()
+}
+
+/// Times each edge of `contacts` on the timing signal `g`: within one period of the detection
+/// cutoff of the filtered edge (the farthest a zero-phase low-pass at that cutoff moves an
+/// edge) and never past the middle of the gap to the neighbouring contact. An edge whose
+/// timing signal never reaches the level there keeps its filtered time.
+fn retime(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions, contacts: &mut [RawContact]) {
+    let n = f.len();
+    let level = opts.off_n;
+    let w = (opts.cutoff_hz.recip() / median_dt(t)).ceil() as usize;
+    let m = contacts.len();
+    for k in 0..m {
+        let (s, e) = (contacts[k].0, contacts[k].1);
+        // First index this contact may claim, last index it may claim.
+        let floor = if k > 0 {
+            (contacts[k - 1].1 + s) / 2 + 1
+        } else {
+            0
+        };
+        let ceil = if k + 1 < m {
+            (e + contacts[k + 1].0).div_ceil(2) - 1
+        } else {
+            n - 1
+        };
+        if contacts[k].2.is_some() {
+            let lo = floor.max(s.saturating_sub(w));
+            if let Some(mut j) = (lo..=e).find(|&j| g[j] >= level) {
+                while j > floor && g[j - 1] >= level {
+                    j -= 1;
+                }
+                if j > 0 {
+                    contacts[k].2 = Some(crossing(t, g, j - 1, level));
+                }
+            }
+        }
+        if contacts[k].3.is_some() {
+            let hi = ceil.min(e + w);
+            if let Some(mut j) = (s..=hi).rev().find(|&j| g[j] >= level) {
+                while j < ceil && g[j + 1] >= level {
+                    j += 1;
+                }
+                if j + 1 < n {
+                    contacts[k].3 = Some(crossing(t, g, j, level));
+                }
+            }
+        }
+    }
+}
+
+/// Median sample interval of `t`, s (1 when it cannot be told).
+fn median_dt(t: &[f64]) -> f64 {
+    let mut d: Vec<f64> = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    if d.is_empty() {
+        return 1.0;
+    }
+    let k = d.len() / 2;
+    *d.select_nth_unstable_by(k, f64::total_cmp).1
 }
 
 /// Mean centre of pressure, its mean time and its velocity over the samples `s..=e` whose
@@ -383,16 +477,25 @@ pub fn detect(
     if trial.plates.is_empty() {
         return Ok(res);
     }
-    if !(opts.on_n > opts.off_n && opts.off_n > 0.0) {
+    if !(opts.on_n >= opts.off_n && opts.off_n > 0.0) {
         return Err(EventError::Options(format!(
-            "force thresholds: on ({} N) must exceed off ({} N) > 0",
+            "force thresholds: on ({} N) must be at least off ({} N), and off above 0",
             opts.on_n, opts.off_n
         )));
     }
+    if let Some(c) = opts.timing_cutoff_hz {
+        if c.is_nan() || c < opts.cutoff_hz {
+            return Err(EventError::Options(format!(
+                "force timing cutoff {c} Hz is below the detection cutoff {} Hz: the events \
+                 are timed on the sharper signal",
+                opts.cutoff_hz
+            )));
+        }
+    }
     let mut unassigned: Vec<Contact> = Vec::new();
     for plate in &trial.plates {
-        let (f, mut report) = vertical_force(plate, axis, &path, opts, &mut res.notes)?;
-        let raw = threshold_contacts(&plate.time_s, &f, opts);
+        let (f, g, mut report) = vertical_force(plate, axis, &path, opts, &mut res.notes)?;
+        let raw = threshold_contacts(&plate.time_s, &f, &g, opts);
         report.contacts = raw.len();
         for (s, e, on, off) in raw {
             let peak = f[s..=e].iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -642,6 +745,89 @@ mod tests {
         assert!((hs[0] - 0.3).abs() < 0.006, "{hs:?}");
         assert!((to[1] - 1.25).abs() < 0.006, "{to:?}");
         assert!(r.events.iter().all(|e| e.side == Side::Right));
+    }
+
+    fn times(r: &ForceResult, kind: EventKind) -> Vec<f64> {
+        r.events
+            .iter()
+            .filter(|e| e.kind == kind)
+            .map(|e| e.time_s)
+            .collect()
+    }
+
+    #[test]
+    fn events_are_timed_on_the_unfiltered_force() {
+        // An 800 N half-sine over (a, b) crosses 20 N at a + (b − a)/π · asin(20/800) and
+        // symmetrically before b. Sampled at 1 kHz, linear interpolation is within 0.1 ms.
+        let (a, b) = (0.3, 0.55);
+        let dt = (b - a) / std::f64::consts::PI * (20.0f64 / 800.0).asin();
+        let p = plate(Some(Side::Right), &[(a, b)], 1000.0, 1.0);
+        let r = detect(&trial(vec![p.clone()]), None, &ForceOptions::default()).unwrap();
+        assert!((times(&r, EventKind::HeelStrike)[0] - (a + dt)).abs() < 1e-4);
+        assert!((times(&r, EventKind::ToeOff)[0] - (b - dt)).abs() < 1e-4);
+        // Timed on the 20 Hz filtered force instead, the contact is longer at both ends.
+        let filtered = ForceOptions {
+            timing_cutoff_hz: Some(20.0),
+            ..ForceOptions::default()
+        };
+        let r = detect(&trial(vec![p]), None, &filtered).unwrap();
+        assert!(times(&r, EventKind::HeelStrike)[0] < a + dt - 1e-3);
+        assert!(times(&r, EventKind::ToeOff)[0] > b - dt + 1e-3);
+    }
+
+    #[test]
+    fn a_sharp_edge_and_dropouts_in_the_tail_are_timed_as_the_force_crosses() {
+        // 300 Hz, like WBDS: the force jumps from 0 to 300 N between two samples, and the
+        // unloading tail has isolated zero samples (121, 0, 83, 0, 0, 0, 56, 0, 0, 29, 0 N).
+        let rate = 300.0;
+        let mut fy = vec![0.0; 300];
+        for v in fy.iter_mut().take(200).skip(60) {
+            *v = 600.0;
+        }
+        fy[60] = 300.0;
+        let tail = [121.0, 0.0, 83.0, 0.0, 0.0, 0.0, 56.0, 0.0, 0.0, 29.0];
+        fy[200..210].copy_from_slice(&tail);
+        let mut p = plate(Some(Side::Left), &[], rate, 1.0);
+        for (f, v) in p.force_n.iter_mut().zip(&fy) {
+            f[1] = *v;
+        }
+        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        // Heel strike between samples 59 (0 N) and 60 (300 N): 59 + 20/300.
+        let hs = times(&r, EventKind::HeelStrike);
+        assert!(
+            (hs[0] - (59.0 + 20.0 / 300.0) / rate).abs() < 1e-9,
+            "{hs:?}"
+        );
+        // Toe off after the last loaded sample (209, 29 N) and before 210 (0 N): 209 + 9/29.
+        let to = times(&r, EventKind::ToeOff);
+        assert!((to[0] - (209.0 + 9.0 / 29.0) / rate).abs() < 1e-9, "{to:?}");
+    }
+
+    #[test]
+    fn a_single_threshold_is_allowed_and_thresholds_are_checked() {
+        let p = plate(Some(Side::Right), &[(0.3, 0.55)], 1000.0, 1.0);
+        let single = ForceOptions {
+            on_n: 50.0,
+            off_n: 50.0,
+            ..ForceOptions::default()
+        };
+        let r = detect(&trial(vec![p.clone()]), None, &single).unwrap();
+        let dt = 0.25 / std::f64::consts::PI * (50.0f64 / 800.0).asin();
+        assert!((times(&r, EventKind::HeelStrike)[0] - (0.3 + dt)).abs() < 1e-4);
+        let inverted = ForceOptions {
+            on_n: 20.0,
+            off_n: 50.0,
+            ..ForceOptions::default()
+        };
+        assert!(detect(&trial(vec![p.clone()]), None, &inverted).is_err());
+        let blunt = ForceOptions {
+            timing_cutoff_hz: Some(10.0),
+            ..ForceOptions::default()
+        };
+        let msg = detect(&trial(vec![p]), None, &blunt)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("timing cutoff"), "{msg}");
     }
 
     #[test]

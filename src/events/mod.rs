@@ -9,6 +9,7 @@
 //! - [`steps`]: one row per step in the trials schema, plus flight height (running paper eq. 3),
 //!   double support (walking paper §3) and the Ko–Badler μ inputs;
 //! - [`compare`]: detection F1 and timing error of one event source against another;
+//! - [`per_event`]: one row per event (trial, time, side, event, method) for external tools;
 //! - [`plot`]: a per-trial SVG of the vertical GRF and foot-marker traces with the events;
 //! - [`markers`]: which marker plays which role, with presets for common marker sets.
 //!
@@ -20,6 +21,7 @@ pub mod force;
 pub mod input;
 pub mod kinematic;
 pub mod markers;
+pub mod per_event;
 pub mod phases;
 pub mod plot;
 pub mod steps;

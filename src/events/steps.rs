@@ -27,7 +27,7 @@
 use super::force::{Contact, ForceResult};
 use super::kinematic::Kinematics;
 use super::phases::mu_inputs;
-use super::{EventError, EventKind, EventOptions, EventSource, Gait, GaitEvent, Side, TrialEvents};
+use super::{EventError, EventKind, EventOptions, Gait, GaitEvent, Side, TrialEvents};
 use crate::ingest::trials::{StepRow, CANONICAL_COLUMNS};
 use crate::ingest::types::{Setting, Trial};
 use crate::units::G;
@@ -114,7 +114,7 @@ pub fn source_label(trial: &Trial) -> String {
 
 /// The subject id from the file, else `<folder>_<trial>`: without subject data, gaitfit cannot
 /// tell whether two files of one folder are one person, and assumes they are not.
-fn subject_label(trial: &Trial) -> String {
+pub fn subject_label(trial: &Trial) -> String {
     if let Some(id) = &trial.subject.id {
         if !id.trim().is_empty() {
             return id.trim().to_string();
@@ -168,15 +168,7 @@ pub fn steps_from_analysis(
     let ev = an.events.primary_events();
     let kin = an.kinematics.as_ref();
     let mut table = StepTable::default();
-    let src_name = match an.events.primary {
-        EventSource::Force => "force",
-        EventSource::ZeniCoordinate => "zeni_coordinate",
-        EventSource::ZeniVelocity => "zeni_velocity",
-        EventSource::Reference => "reference",
-        EventSource::FootMarkers => "foot_height",
-        EventSource::FootSpeed => "foot_speed",
-        EventSource::Generated => "generated",
-    };
+    let src_name = an.events.primary.as_str();
     let setting = opts.setting.unwrap_or(match (trial.setting, kin) {
         (Setting::Unknown, Some(k)) => k.setting,
         (s, _) => s,

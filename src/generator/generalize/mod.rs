@@ -53,9 +53,9 @@ use crate::generator::GenerateError;
 /// `tests/kb_mu_fit.rs`.
 pub const DEFAULT_ALPHA: [f64; 4] = [
     0.0,
-    0.4173280780882365,
-    1.1615913945305023,
-    1.6163145973524753,
+    0.4511971590061217,
+    1.1659972253651565,
+    1.619077948128876,
 ];
 
 /// A prototype walk W(S*, sl*) with its μ-functions: the generator of every other step.
