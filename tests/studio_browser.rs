@@ -482,5 +482,17 @@ fn studio_in_chromium() {
             );
         }
     }
+    // Ko–Badler draws too, with its one reference plot.
+    let s = seq(&mut cdp);
+    cdp.eval("window.studio.setGenerator('generalize')");
+    cdp.settle(s);
+    assert_eq!(cdp.eval("window.studio.lastError"), json!(""));
+    assert_eq!(
+        cdp.eval("document.querySelectorAll('#plots canvas').length"),
+        json!(1)
+    );
+    let sl0 = shown(&mut cdp, "step_length_m");
+    set_number(&mut cdp, "step_length_m", sl0 + 0.1);
+    assert!((shown(&mut cdp, "step_length_m") - sl0 - 0.1).abs() < 1e-6);
     assert_eq!(cdp.console_errors, Vec::<String>::new(), "console errors");
 }
