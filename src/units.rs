@@ -368,6 +368,105 @@ pub fn parse_header(header: &str) -> Result<Option<Column>, UnknownUnit> {
     }
 }
 
+/// A command-line value that could not be read ([`parse_value`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{text:?}: {reason}")]
+pub struct ValueError {
+    /// The text given.
+    pub text: String,
+    /// What is wrong, with the accepted units.
+    pub reason: String,
+}
+
+/// The unit written after a number on the command line or in a schedule cell, for `dim`:
+/// the spellings people type (`km/h`, `/min`, `Hz`, `°`) and the header suffixes
+/// ([`Unit::suffix`]: `km_per_h`, `steps_per_min`, …). `None` if `unit` is not one of them.
+pub fn value_unit(dim: Dimension, unit: &str) -> Option<Unit> {
+    let u = unit.to_ascii_lowercase();
+    let typed = match (dim, u.as_str()) {
+        (Dimension::Speed, "m/s" | "mps") => Some(Unit::MPerS),
+        (Dimension::Speed, "km/h" | "kmh" | "kph") => Some(Unit::KmPerH),
+        (Dimension::Speed, "m/min") => Some(Unit::MPerMin),
+        (Dimension::Frequency, "/min" | "spm" | "steps/min") => Some(Unit::StepsPerMin),
+        (Dimension::Frequency, "/s" | "steps/s") => Some(Unit::StepsPerS),
+        (Dimension::Angle, "°") => Some(Unit::Deg),
+        (Dimension::PercentCycle, "%") => Some(Unit::PctCycle),
+        _ => None,
+    };
+    typed.or_else(|| dim.units().iter().copied().find(|x| x.suffix() == u))
+}
+
+/// The unit of a bare number for `dim` on the command line: m, m/s, steps/min, s, degrees, %.
+pub fn bare_unit(dim: Dimension) -> Unit {
+    match dim {
+        Dimension::Length => Unit::M,
+        Dimension::Speed => Unit::MPerS,
+        Dimension::Frequency => Unit::StepsPerMin,
+        Dimension::Time => Unit::S,
+        Dimension::PercentCycle => Unit::PctCycle,
+        Dimension::Angle => Unit::Deg,
+    }
+}
+
+/// Parses a number with an optional unit into SI for `dim` — the one parser of values with
+/// units for the whole command line (speeds, lengths, frequencies, durations, angles):
+/// `12km/h`, `3.3 m/s`, `200m/min`, `1.07m`, `107cm`, `4mm`, `187/min`, `3.1Hz`, `15deg`,
+/// `0.26rad`, `250ms`, or a header suffix (`12km_per_h`). A bare number is in
+/// [`bare_unit`]'s unit (m, m/s, steps/min, s, degrees).
+///
+/// ```
+/// use gaitfit::units::{parse_value, Dimension};
+/// assert!((parse_value("12km/h", Dimension::Speed).unwrap() - 12.0 / 3.6).abs() < 1e-12);
+/// assert!((parse_value("187/min", Dimension::Frequency).unwrap() - 187.0 / 60.0).abs() < 1e-12);
+/// assert!((parse_value("180cm", Dimension::Length).unwrap() - 1.8).abs() < 1e-12);
+/// assert!(parse_value("12 furlongs", Dimension::Speed).is_err());
+/// ```
+pub fn parse_value(text: &str, dim: Dimension) -> Result<f64, ValueError> {
+    let err = |reason: String| ValueError {
+        text: text.to_string(),
+        reason,
+    };
+    let t: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let split = t
+        .char_indices()
+        .find(|&(i, c)| {
+            !(c.is_ascii_digit()
+                || c == '.'
+                || ((c == '-' || c == '+') && (i == 0 || t[..i].ends_with(['e', 'E'])))
+                || ((c == 'e' || c == 'E')
+                    && i > 0
+                    && t[i + 1..]
+                        .starts_with(|d: char| d.is_ascii_digit() || d == '-' || d == '+')))
+        })
+        .map_or(t.len(), |(i, _)| i);
+    let (num, unit) = t.split_at(split);
+    let v: f64 = num
+        .parse()
+        .map_err(|_| err("no number at the start".into()))?;
+    if !v.is_finite() {
+        return Err(err("not a finite number".into()));
+    }
+    let unit = if unit.is_empty() {
+        bare_unit(dim)
+    } else {
+        value_unit(dim, unit).ok_or_else(|| {
+            let accepted = match dim {
+                Dimension::Speed => "km/h, m/s, m/min",
+                Dimension::Length => "m, cm, mm, in",
+                Dimension::Frequency => "/min (steps/min), Hz or /s (steps/s)",
+                Dimension::Angle => "deg, rad",
+                Dimension::Time => "s, ms",
+                Dimension::PercentCycle => "%",
+            };
+            err(format!(
+                "unknown unit {unit:?}; use {accepted} (a bare number is {})",
+                bare_unit(dim).suffix().replace("_per_", "/")
+            ))
+        })?
+    };
+    Ok(v * unit.to_si_factor())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -438,6 +537,52 @@ mod tests {
                 "{h}"
             );
         }
+    }
+
+    #[test]
+    fn values_with_units() {
+        let close = |t: &str, d: Dimension, v: f64| {
+            let got = parse_value(t, d).unwrap();
+            assert!(
+                (got - v).abs() < 1e-12 * v.abs().max(1.0),
+                "{t}: {got} vs {v}"
+            );
+        };
+        close("12km/h", Dimension::Speed, 12.0 / 3.6);
+        close("12 km/h", Dimension::Speed, 12.0 / 3.6);
+        close("12kmh", Dimension::Speed, 12.0 / 3.6);
+        close("12km_per_h", Dimension::Speed, 12.0 / 3.6);
+        close("3.3m/s", Dimension::Speed, 3.3);
+        close("1.4", Dimension::Speed, 1.4);
+        close("84m/min", Dimension::Speed, 1.4);
+        close("187/min", Dimension::Frequency, 187.0 / 60.0);
+        close("187", Dimension::Frequency, 187.0 / 60.0);
+        close("3.1Hz", Dimension::Frequency, 3.1);
+        close("3.1steps_per_s", Dimension::Frequency, 3.1);
+        close("4mm", Dimension::Length, 0.004);
+        close("180cm", Dimension::Length, 1.8);
+        close("70in", Dimension::Length, 1.778);
+        close("1e-3m", Dimension::Length, 0.001);
+        close("1.5e+2cm", Dimension::Length, 1.5);
+        close("-15deg", Dimension::Angle, -15f64.to_radians());
+        close("15°", Dimension::Angle, 15f64.to_radians());
+        close("0.2rad", Dimension::Angle, 0.2);
+        close("250ms", Dimension::Time, 0.25);
+        for (t, d) in [
+            ("12 furlongs", Dimension::Speed),
+            ("fast", Dimension::Speed),
+            ("1.8kg", Dimension::Length),
+            ("inf", Dimension::Length),
+            ("1-2m", Dimension::Length),
+            ("", Dimension::Time),
+        ] {
+            let e = parse_value(t, d).unwrap_err().to_string();
+            assert!(e.contains(&format!("{t:?}")), "{e}");
+        }
+        let e = parse_value("12mph", Dimension::Speed)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("km/h, m/s, m/min"), "{e}");
     }
 
     #[test]

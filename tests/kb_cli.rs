@@ -15,7 +15,7 @@ fn writes_a_bvh_for_a_tall_figure() {
             "--step-length",
             "0.9",
         ])
-        .args(["--steps", "4", "-o", "walk.bvh"])
+        .args(["--count", "4", "-o", "walk.bvh"])
         .assert()
         .success();
     let bvh = gaitfit::export::bvh::read(&dir.path().join("walk.bvh")).unwrap();
@@ -41,7 +41,7 @@ fn follows_a_schedule_and_reports_bad_rows() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("steps.csv"),
-        "step_length_m,duration_s\n0.6,0.5\n0.7,\n0.65,0.52\n",
+        "step_length_m,step_freq_steps_per_min\n0.6,120\n0.7,\n0.65,115.4\n",
     )
     .unwrap();
     Command::cargo_bin("gaitfit")
@@ -100,7 +100,7 @@ fn a_written_prototype_reads_back() {
             "--step-length",
             "0.7",
         ])
-        .args(["--steps", "2", "-o", "w.trc"])
+        .args(["--count", "2", "-o", "w.trc"])
         .assert()
         .success();
     assert!(dir.path().join("w.trc").exists());

@@ -170,7 +170,7 @@ fn schedule_file_reads_and_drives_a_walk() {
     std::fs::write(&path, "steps,speed_km_per_h\n4,fast\n").unwrap();
     let e = read_schedule(&path).unwrap_err().to_string();
     assert!(
-        e.contains("fig8.csv") && e.contains("row 2") && e.contains("speed_km_per_h"),
+        e.contains("fig8.csv") && e.contains("row 1") && e.contains("speed_km_per_h"),
         "{e}"
     );
 }

@@ -47,7 +47,7 @@ fn schedule_accelerates_8_to_20_then_stops_standing() {
             "--seconds",
             "12",
         ])
-        .args(["--steps", "table.csv", "-o", "run.csv"])
+        .args(["--steps-out", "table.csv", "-o", "run.csv"])
         .assert()
         .success();
     // The steps follow the schedule: 8 km/h from the start, 20 km/h from step 16, then a
@@ -209,5 +209,5 @@ fn bad_input_names_the_problem_and_writes_nothing() {
         .assert()
         .failure();
     let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
-    assert!(err.contains("s.csv") && err.contains("line 3"), "{err}");
+    assert!(err.contains("s.csv") && err.contains("row 2"), "{err}");
 }

@@ -86,7 +86,7 @@ fn generated_steps_refit_to_the_generating_coefficients() {
                 "--fits",
             ])
             .arg(&fits)
-            .args(["--seconds", "10", "--steps"])
+            .args(["--seconds", "10", "--steps-out"])
             .arg(&steps)
             .args(["-o", &format!("run_{h}.csv")])
             .assert()

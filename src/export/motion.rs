@@ -42,11 +42,29 @@ impl MotionFormat {
     }
 }
 
+/// Options of [`write_with`] (what a format leaves open).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MotionOptions {
+    /// Length unit of a BVH file (metres by default).
+    pub bvh_unit: super::bvh::BvhUnit,
+}
+
 /// Writes `motion` to `path` in the format its extension names (`.bvh`, `.csv`, `.trc`); a CSV
 /// also writes its events to `<stem>_events.csv` next to it. Files are written atomically.
 pub fn write(motion: &Motion, path: &Path) -> Result<(), ExportError> {
+    write_with(motion, path, &MotionOptions::default())
+}
+
+/// [`write`] with options.
+pub fn write_with(motion: &Motion, path: &Path, opts: &MotionOptions) -> Result<(), ExportError> {
     match MotionFormat::from_path(path)? {
-        MotionFormat::Bvh => super::bvh::write(motion, path, &super::bvh::BvhOptions::default()),
+        MotionFormat::Bvh => super::bvh::write(
+            motion,
+            path,
+            &super::bvh::BvhOptions {
+                unit: opts.bvh_unit,
+            },
+        ),
         MotionFormat::Csv => {
             super::motion_csv::write(motion, path)?;
             super::motion_csv::write_events(motion, &super::motion_csv::events_path(path))

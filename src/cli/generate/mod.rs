@@ -2,6 +2,7 @@
 use clap::Subcommand;
 use std::process::ExitCode;
 
+pub mod common;
 pub mod generalize;
 pub mod run;
 pub mod walk;

@@ -1,15 +1,15 @@
 //! `gaitfit generate run`: RUNNER (Bruderlin & Calvert 1996), a run from a stand at a speed (and
 //! optionally step length, step frequency, flight height, level, attributes, a per-step
 //! schedule), written as BVH, CSV (+ events CSV) or TRC.
+use super::common::{freq_arg, length_arg, speed_arg, Common};
 use crate::generator::running::attributes::{unit_name, AttrUnit, SPECS};
 use crate::generator::running::equations::RunRelations;
 use crate::generator::running::params::default_mass;
-use crate::generator::running::schedule::parse_value;
 use crate::generator::running::{
     generate_run, Attr, GenerateOptions, Param, RunAttributes, RunModel, Schedule,
 };
 use crate::generator::skeleton::Skeleton;
-use crate::units::Dimension;
+use crate::units::{parse_value, Dimension};
 use anyhow::{bail, Context};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -20,25 +20,25 @@ use std::process::ExitCode;
 pub struct Args {
     /// Speed: `12km/h`, `3.3m/s`, `200m/min` (a bare number is m/s). Without it and without
     /// --step-length/--step-freq: 12 km/h.
-    #[arg(long)]
-    pub speed: Option<String>,
+    #[arg(long, value_name = "SPEED", value_parser = speed_arg)]
+    pub speed: Option<f64>,
     /// Step length: `1.07m`, `107cm` (bare: m). Held fixed together with the other parameters
     /// given; eq. 2 gives way.
-    #[arg(long = "step-length")]
-    pub step_length: Option<String>,
+    #[arg(long = "step-length", value_name = "LENGTH", value_parser = length_arg)]
+    pub step_length: Option<f64>,
     /// Step frequency: `187/min`, `3.1Hz` (bare: steps/min).
-    #[arg(long = "step-freq")]
-    pub step_freq: Option<String>,
+    #[arg(long = "step-freq", value_name = "FREQ", value_parser = freq_arg)]
+    pub step_freq: Option<f64>,
     /// Flight height H (eq. 3): `0.004m`, `4mm` (bare: m). The flight time then follows from H.
-    #[arg(long = "flight-height")]
-    pub flight_height: Option<String>,
+    #[arg(long = "flight-height", value_name = "LENGTH", value_parser = length_arg)]
+    pub flight_height: Option<f64>,
     /// Expertise level, −1 (poor) … 1 (skilled) (scaled to the paper's ±0.001 in eq. 2 and
     /// ±0.0001 in eqs. 4–5).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub level: f64,
     /// Body height: `1.8`, `180cm`.
-    #[arg(long, default_value = "1.8")]
-    pub height: String,
+    #[arg(long, value_name = "LENGTH", default_value = "1.8", value_parser = length_arg)]
+    pub height: f64,
     /// An attribute, `name=value` in its unit (degrees, metres, factor; `strike=heel|toe`);
     /// repeatable; see the list below.
     #[arg(long = "attr", value_name = "NAME=VALUE")]
@@ -47,38 +47,21 @@ pub struct Args {
     /// step-freq, flight-height).
     #[arg(long, value_delimiter = ',')]
     pub lock: Vec<String>,
-    /// Per-step schedule CSV (`step`, `speed_km_per_h`|`speed_m_per_s`, `step_length_m`,
-    /// `step_freq_steps_per_min`, `flight_height_m`, `level`, `action` = run|stop).
-    #[arg(long)]
-    pub schedule: Option<PathBuf>,
     /// Folder with refitted relations (`run-sl-v.json`, `run-tflight-sf.json`); the published
     /// coefficients otherwise.
     #[arg(long)]
     pub fits: Option<PathBuf>,
-    /// Duration, s.
-    #[arg(long, default_value_t = 10.0)]
-    pub seconds: f64,
-    /// Frames per second of the output.
-    #[arg(long, default_value_t = 120.0)]
-    pub fps: f64,
-    /// Do not stop at the end (by default the run ends standing by --seconds).
+    /// Do not stop at the end (by default the run ends standing by --seconds, or after --count
+    /// steps).
     #[arg(long = "no-stop")]
     pub no_stop: bool,
-    /// Also write the generated steps to this CSV in the trials schema that `gaitfit fit`
-    /// reads (subject, gait, side, time, speed, step length, frequency, stance and flight time,
-    /// flight height, body and leg length; the final stop is not a step).
-    #[arg(long = "steps")]
-    pub steps_csv: Option<PathBuf>,
-    /// Subject name written to the --steps table (default `runner-<height>m`).
-    #[arg(long)]
-    pub subject: Option<String>,
     /// Also write the generator's plan of each step (kind, start, duration, parameters, flight
     /// case, pelvis at toe off and heel strike, p, recoveries) to this CSV.
     #[arg(long = "plan")]
     pub plan_csv: Option<PathBuf>,
-    /// Output file: `.bvh`, `.csv` (plus `<stem>_events.csv`) or `.trc`.
-    #[arg(short = 'o', long)]
-    pub output: PathBuf,
+    /// The flags shared by every generator.
+    #[command(flatten)]
+    pub common: Common,
 }
 
 fn attribute_help() -> String {
@@ -123,9 +106,11 @@ fn value(flag: &str, text: &str, dim: Dimension) -> anyhow::Result<f64> {
 
 /// Runs `gaitfit generate run`.
 pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
-    let height = value("--height", &args.height, Dimension::Length)?;
+    let c = &args.common;
+    let output = c.output()?;
+    let height = args.height;
     let skeleton = Skeleton::from_height(height, default_mass(height))
-        .with_context(|| format!("--height {}", args.height))?;
+        .with_context(|| format!("--height {height}"))?;
     let relations = match &args.fits {
         Some(dir) => RunRelations::from_fits(dir)?,
         None => RunRelations::published(),
@@ -156,28 +141,15 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     }
     // Parameters: start natural at the given speed (or 12 km/h), then fix each parameter given,
     // holding the earlier ones (as one schedule row does).
-    let mut given: Vec<(Param, f64)> = Vec::new();
-    if let Some(s) = &args.speed {
-        given.push((Param::Speed, value("--speed", s, Dimension::Speed)?));
-    }
-    if let Some(s) = &args.step_length {
-        given.push((
-            Param::StepLength,
-            value("--step-length", s, Dimension::Length)?,
-        ));
-    }
-    if let Some(s) = &args.step_freq {
-        given.push((
-            Param::StepFreq,
-            value("--step-freq", s, Dimension::Frequency)?,
-        ));
-    }
-    if let Some(s) = &args.flight_height {
-        given.push((
-            Param::FlightHeight,
-            value("--flight-height", s, Dimension::Length)?,
-        ));
-    }
+    let given: Vec<(Param, f64)> = [
+        (Param::Speed, args.speed),
+        (Param::StepLength, args.step_length),
+        (Param::StepFreq, args.step_freq),
+        (Param::FlightHeight, args.flight_height),
+    ]
+    .into_iter()
+    .filter_map(|(p, v)| v.map(|v| (p, v)))
+    .collect();
     let start_v = given
         .iter()
         .find(|(p, _)| *p == Param::Speed)
@@ -192,30 +164,35 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     for l in &args.lock {
         params.locks.set(param_of(l)?, true);
     }
-    let schedule = match &args.schedule {
+    let mut schedule = match &c.schedule {
         Some(p) => Some(Schedule::from_csv(p)?),
         None => None,
     };
+    if let Some(n) = c.count {
+        let s = schedule.get_or_insert_with(Schedule::default);
+        if s.end_step.is_some() {
+            eprintln!(
+                "gaitfit: note: {} holds its own number of steps; --count is not used",
+                s.source
+            );
+        } else {
+            s.end_step = Some(n);
+        }
+    }
     let opts = GenerateOptions {
-        seconds: args.seconds,
-        fps: args.fps,
+        seconds: c.seconds(),
+        fps: c.fps,
         stop_at_end: !args.no_stop,
     };
     let (motion, report) = generate_run(&model, params, attrs, schedule, &opts)?;
-    crate::export::motion::write(&motion, &args.output)?;
-    if let Some(path) = &args.steps_csv {
-        let subject = args
+    c.write_motion(&motion)?;
+    if c.steps_out.is_some() {
+        let subject = c
             .subject
             .clone()
             .unwrap_or_else(|| format!("runner-{height:.2}m"));
-        let trial = args
-            .output
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
         let leg = model.skeleton.anthropometry().hip_height_m();
-        crate::ingest::trials::write_trials(path, &report.step_rows(&subject, &trial, Some(leg)))
-            .with_context(|| format!("writing {}", path.display()))?;
+        c.write_steps(&report.step_rows(&subject, &c.trial(), Some(leg)))?;
     }
     if let Some(path) = &args.plan_csv {
         write_plan(path, &report)?;
@@ -251,7 +228,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     for n in &report.notes {
         println!("  note: {n}");
     }
-    println!("  wrote {}", args.output.display());
+    println!("  wrote {}", output.display());
     Ok(ExitCode::SUCCESS)
 }
 

@@ -117,8 +117,9 @@ fn stop_duration_estimate(params: &RunParams) -> f64 {
     (n + 1.0) / params.step_freq + (0.45 + 0.12 * v_stop) * fr + 0.1
 }
 
-/// Generates a run from a stand: `seconds` of motion at `fps`, starting with `params` and
-/// `attrs` and following `schedule` if given.
+/// Generates a run from a stand: `seconds` of motion at `fps` (or, if the schedule has an
+/// [`Schedule::end_step`], that many steps), starting with `params` and `attrs` and following
+/// `schedule` if given.
 pub fn generate_run(
     model: &RunModel,
     params: RunParams,
@@ -152,21 +153,41 @@ pub fn generate_run(
         meta.push(key, val);
     }
     let mut motion = Motion::new(model.skeleton.clone(), opts.fps, meta)?;
+    // A schedule with a length (`steps` column, `--count`) ends the run after that many steps
+    // instead of `seconds`; ending in a stand, the stop decelerates from the step after them.
+    let end_step = schedule.as_ref().and_then(|s| s.end_step);
+    let mut schedule = schedule;
+    if let (Some(k), Some(s)) = (end_step, schedule.as_mut()) {
+        if opts.stop_at_end && !s.stops() {
+            s.rows.push(schedule::ScheduleRow {
+                step: k,
+                set: Vec::new(),
+                level: None,
+                stop: true,
+                row: 0,
+            });
+        }
+    }
     let scheduled_stop = schedule.as_ref().is_some_and(|s| s.stops());
     let mut runner = Runner::new(model.clone(), params, attrs, schedule)?;
     let n = (opts.seconds * opts.fps).round() as usize + 1;
     motion.reserve(n);
-    let stop_at = if opts.stop_at_end && !scheduled_stop {
+    let stop_at = if opts.stop_at_end && !scheduled_stop && end_step.is_none() {
         Some(opts.seconds - stop_duration_estimate(&params))
     } else {
         None
+    };
+    // A stop that never comes to a stand ends 60 s late; a run of so many steps, at 1 h.
+    let limit = match end_step {
+        Some(_) => (3600.0 * opts.fps) as usize,
+        None => n + (60.0 * opts.fps) as usize,
     };
     let mut pose = model.skeleton.rest_pose();
     let mut i = 0usize;
     let mut stopped_at: Option<usize> = None;
     loop {
         let t = i as f64 / opts.fps;
-        let past_end = i >= n;
+        let past_end = end_step.map_or(i >= n, |k| runner.step_index() >= k);
         let standing = runner.state() == RunState::Stopped;
         if standing && stopped_at.is_none() {
             stopped_at = Some(i);
@@ -175,7 +196,7 @@ pub fn generate_run(
         if past_end
             && (stopped_at.is_some_and(|s| i >= s + (0.2 * opts.fps) as usize)
                 || !(opts.stop_at_end || scheduled_stop)
-                || i > n + (60.0 * opts.fps) as usize)
+                || i > limit)
         {
             break;
         }
@@ -199,7 +220,8 @@ pub fn generate_run(
         .steps()
         .iter()
         .copied()
-        .filter(|s| s.start_s <= end)
+        // Without a stop, a run of `end_step` steps ends on the first frame of the next one.
+        .filter(|s| s.start_s <= end && (scheduled_stop || end_step.is_none_or(|k| s.index < k)))
         .collect();
     let mut notes = Vec::new();
     for s in &steps {

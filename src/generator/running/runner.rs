@@ -235,7 +235,7 @@ impl Runner {
                 Err(e) => {
                     result = Err(GenerateError::Input {
                         path: schedule.source.clone(),
-                        message: format!("line {}: {e}", row.line),
+                        message: format!("row {}: {e}", row.row),
                     });
                     break;
                 }

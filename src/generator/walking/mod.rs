@@ -252,80 +252,20 @@ pub fn ramp_schedule(
     Ok((steps, notes))
 }
 
-/// Reads a schedule CSV: one row per stretch with columns `steps` and any of `speed_m_per_s`
-/// (or `speed_km_per_h`), `step_length_m`, `step_freq_steps_per_min`; empty cells mean "not
-/// given" (completed by eq. 1).
+/// Reads a schedule CSV (the columns shared by every generator,
+/// [`crate::generator::schedule`]) as KLAW's stretches. It needs a length of its own (a `steps`
+/// column, or one step per row) and no `stop` (set [`WalkOptions::stop`]; the command line
+/// reads `action = stop` itself).
 pub fn read_schedule(path: &Path) -> Result<Vec<ScheduleEntry>, GenerateError> {
-    let bad = |row: usize, col: &str, msg: String| GenerateError::Parameter {
-        name: "schedule".into(),
-        value: f64::NAN,
-        message: format!("{}: row {row}, column {col}: {msg}", path.display()),
-    };
-    let mut rdr = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| bad(0, "-", format!("cannot read: {e}")))?;
-    let headers = rdr
-        .headers()
-        .map_err(|e| bad(1, "-", e.to_string()))?
-        .clone();
-    let col = |name: &str| headers.iter().position(|h| h == name);
-    let steps_col = col("steps").ok_or_else(|| bad(1, "steps", "missing column `steps`".into()))?;
-    let known = [
-        "steps",
-        "speed_m_per_s",
-        "speed_km_per_h",
-        "step_length_m",
-        "step_freq_steps_per_min",
-    ];
-    if let Some(h) = headers.iter().find(|h| !known.contains(h)) {
-        return Err(bad(
-            1,
-            h,
-            format!("unknown column; expected {}", known.join(", ")),
-        ));
-    }
-    let mut out = Vec::new();
-    for (i, rec) in rdr.records().enumerate() {
-        let row = i + 2;
-        let rec = rec.map_err(|e| bad(row, "-", e.to_string()))?;
-        let num = |name: &str| -> Result<Option<f64>, GenerateError> {
-            match col(name).and_then(|c| rec.get(c)) {
-                None | Some("") => Ok(None),
-                Some(s) => s
-                    .parse::<f64>()
-                    .map(Some)
-                    .map_err(|_| bad(row, name, format!("{s:?} is not a number"))),
-            }
-        };
-        let steps_s = rec.get(steps_col).unwrap_or("");
-        let steps: usize = steps_s.parse().map_err(|_| {
-            bad(
-                row,
-                "steps",
-                format!("{steps_s:?} is not a whole number of steps"),
-            )
-        })?;
-        let speed = match (num("speed_m_per_s")?, num("speed_km_per_h")?) {
-            (Some(_), Some(_)) => {
-                return Err(bad(
-                    row,
-                    "speed_km_per_h",
-                    "give the speed in one unit only".into(),
-                ))
-            }
-            (a, b) => a.or(b.map(crate::units::km_per_h_to_m_per_s)),
-        };
-        out.push(ScheduleEntry {
-            params: WalkParams {
-                speed_m_per_s: speed,
-                step_length_m: num("step_length_m")?,
-                step_freq_steps_per_min: num("step_freq_steps_per_min")?,
-            },
-            steps,
+    let s =
+        crate::generator::schedule::Schedule::from_csv(path)?.walk(None, WalkParams::default())?;
+    if s.stop {
+        return Err(GenerateError::Input {
+            path: path.display().to_string(),
+            message: "action stop: set WalkOptions::stop instead".into(),
         });
     }
-    Ok(out)
+    Ok(s.entries)
 }
 
 #[cfg(test)]
