@@ -119,6 +119,9 @@ pub struct Prepared {
     pub subject: Vec<usize>,
     /// Subjects among the used rows, in order of first appearance.
     pub subjects: Vec<String>,
+    /// Per observation: index into `files`, the data set it came from (reports colour
+    /// residuals by subject and data set, so treadmill and overground rows are not pooled).
+    pub file: Vec<u32>,
     /// Per observation: weight (all 1 without `--weights`).
     pub weights: Vec<f64>,
     /// Rejections by reason.
@@ -147,6 +150,7 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
     p.obs.reserve(tables.iter().map(|t| t.len()).sum());
     for t in tables {
         let file = t.path.display().to_string();
+        let file_index = p.files.len() as u32;
         p.files.push(DataFile {
             path: file.clone(),
             sha256: t.sha256.clone(),
@@ -228,6 +232,7 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
                         };
                         p.obs.push(o);
                         p.subject.push(k);
+                        p.file.push(file_index);
                         p.weights.push(w);
                         used = true;
                     }

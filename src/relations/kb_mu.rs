@@ -83,6 +83,12 @@ const SL_STAR: usize = 8;
 const LL_STAR: usize = 9;
 /// Names of the four outputs.
 const OUTPUT_NAMES: [&str; 4] = ["mu1", "mu2", "mu3", "mu4"];
+const OUTPUT_LABELS: [&str; 4] = [
+    "μ1: knee flexion at heel strike",
+    "μ2: foot angle at heel strike",
+    "μ3: foot angle at toe off",
+    "μ4: meta angle at toe off",
+];
 
 const INPUTS: &[Variable] = &[
     Variable {
@@ -310,6 +316,9 @@ impl Relation for KbMu {
     }
     fn output_name(&self, k: usize) -> String {
         OUTPUT_NAMES[k.min(3)].to_string()
+    }
+    fn output_label(&self, k: usize) -> String {
+        OUTPUT_LABELS[k.min(3)].to_string()
     }
     fn select_output(&self, x: &mut [f64], k: usize) {
         x[1] = k as f64;

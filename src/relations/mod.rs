@@ -657,6 +657,11 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
         self.response().symbol.to_string()
     }
 
+    /// What output `k` is, for a plot panel's label; by default its name.
+    fn output_label(&self, k: usize) -> String {
+        self.output_name(k)
+    }
+
     /// Sets the inputs that select output `k` (for plotting one curve per output).
     fn select_output(&self, x: &mut [f64], k: usize) {
         let _ = (x, k);

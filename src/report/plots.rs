@@ -1,30 +1,61 @@
-//! Per-relation plots (plotters; SVG and PNG): the data with the refit curve, its 95 % band and
-//! the published curve (in the style of the running paper's Figure 2), residuals against fitted
-//! values, and a normal Q–Q plot of the residuals.
+//! Per-relation plots (plotters; SVG and PNG of each), in the style of the running paper's
+//! Figure 2:
 //!
-//! PNG text needs a font: plotters is built without system fonts, so DejaVu Sans (bundled in
-//! `assets/fonts/`, with its licence) is registered once through `register_font`.
-use super::ReportError;
+//! - `<id>`: the data with the refit curve, its 95 % band and the published curve; relations
+//!   with further inputs (body height) or per-subject levels also get each colour group's refit
+//!   at its own mean inputs and level (run-sl-v: one curve per subject at its height); a
+//!   relation with several outputs (kb-mu's four μ) gets one labelled panel per output;
+//! - `<id>-residuals`: residuals against fitted values;
+//! - `<id>-residuals-inputs`: residuals against each input (one panel per input and output);
+//! - `<id>-qq`: a normal Q–Q plot of the residuals.
+//!
+//! What of the data is drawn is decided in [`super::layers`]: up to
+//! [`MAX_SCATTER_POINTS`] rows every row is a point,
+//! coloured by subject (within data set) or by data set; above that the density of all rows is
+//! drawn, with each colour group's binned mean over it, and the Q–Q plot draws exact order
+//! statistics at fixed ranks ([`super::qq`]). Curves and bands are evaluated at
+//! [`CURVE_POINTS`] abscissae, never at the rows. So the files' sizes and the time to draw them
+//! do not grow with the rows; every figure's legend and its caption in `summary.md` say what
+//! was drawn.
+//!
+//! PNG text is drawn by [`super::raster`] (plotters 0.3.7 misplaces ab_glyph glyphs); the SVG
+//! backend lays text out with plotters' ab_glyph font, registered once from the bundled DejaVu
+//! Sans (`assets/fonts/`, with its licence).
+use super::layers::{
+    Axis, DataLayer, Density, Extent, Frame, GroupBy, GroupInputs, Groups, Source,
+    MAX_SCATTER_POINTS, MEAN_BINS, MIN_MEAN_BIN_ROWS, PALETTE,
+};
+use super::{qq, raster, ticks, Figure, ReportError};
 use crate::fit::pipeline::FitOutcome;
-use crate::fit::stats::normal_quantile;
 use crate::fsio::write_atomic_bytes;
+use crate::relations::{Relation, MAX_INPUTS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
 fn register_font() {
     REGISTER.call_once(|| {
-        // The bundled font is valid; if registration failed PNGs would lack text, not fail.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+        // The bundled font is valid; if registration failed SVGs would lack text, not fail.
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, raster::FONT_BYTES);
     });
 }
 
-const W: u32 = 800;
-const H: u32 = 560;
+/// Figure size, px.
+pub const SIZE: (u32, u32) = (960, 600);
+/// Width of the legend strip at the figure's right, px (room for a 30-character label).
+const LEGEND_W: u32 = 240;
+/// Abscissae at which every curve and band is evaluated (≈ 3 px apart on a full panel).
+pub const CURVE_POINTS: usize = 240;
+/// Density cells of a full-width panel (≈ 7 px square on the ~660 × 450 px plotting area);
+/// panels of a grid get proportionally fewer, so a cell stays ~7 px.
+const DENSITY_CELLS: (usize, usize) = (96, 64);
+
+const FONT: &str = "sans-serif";
+const PUBLISHED: RGBColor = RGBColor(200, 0, 0);
+const BAND: RGBColor = RGBColor(90, 110, 150);
 
 fn perr(path: &Path, e: impl std::fmt::Display) -> ReportError {
     ReportError::Plot {
@@ -34,291 +65,1051 @@ fn perr(path: &Path, e: impl std::fmt::Display) -> ReportError {
 }
 
 fn pad(lo: f64, hi: f64) -> (f64, f64) {
-    let span = (hi - lo).abs().max(1e-9);
-    (lo - 0.05 * span, hi + 0.05 * span)
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    let span = (hi - lo).abs().max(1e-9 * lo.abs().max(1.0));
+    (lo - 0.04 * span, hi + 0.04 * span)
 }
 
-/// Data, refit curve with 95 % band, published curve.
-fn main_plot<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    o: &FitOutcome,
-) -> Result<(), String> {
+fn group_color(g: u16) -> RGBColor {
+    let (r, gg, b) = PALETTE[g as usize % PALETTE.len()];
+    RGBColor(r, gg, b)
+}
+
+/// How a line is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum LineKind {
+    /// The refit for the average subject.
+    Refit,
+    /// The published relation.
+    Published,
+    /// A colour group's refit at its own inputs and level.
+    GroupCurve(u16),
+    /// A colour group's binned mean (over a density).
+    GroupMean(u16),
+    /// A reference line (residual 0, the normal line of a Q–Q plot).
+    Reference,
+}
+
+#[derive(Debug, Clone)]
+struct Line {
+    pts: Vec<(f64, f64)>,
+    kind: LineKind,
+}
+
+#[derive(Debug, Clone)]
+struct Panel {
+    /// The rows drawn (`None`: the data layer is filled in directly, as the Q–Q plot's).
+    source: Option<Source>,
+    title: Option<String>,
+    x_desc: String,
+    y_desc: String,
+    x: (f64, f64),
+    y: (f64, f64),
+    data: DataLayer,
+    /// `(x, lo, hi)` of the refit's 95 % band.
+    band: Vec<(f64, f64, f64)>,
+    lines: Vec<Line>,
+}
+
+/// A figure, fully reduced: drawing it costs the same whatever the number of rows.
+#[derive(Debug, Clone)]
+struct Spec {
+    stem: String,
+    title: String,
+    panels: Vec<Panel>,
+    grid: (usize, usize),
+    /// Whether a density draws each colour group's binned mean.
+    group_means: bool,
+    /// Legend lines about the data layer (first line names what was drawn).
+    data_legend: Vec<String>,
+    groups: Option<(String, Vec<String>)>,
+    /// The largest density count (a colour bar is drawn when some).
+    density_max: Option<u32>,
+    lines_legend: Vec<(LineKind, String)>,
+    shows: String,
+    drawn: String,
+}
+
+/// The curve-evaluation point `x` for output `out` with input 0 at `x0` and other inputs at
+/// `base`.
+fn at(
+    rel: &dyn Relation,
+    base: &[f64; MAX_INPUTS],
+    out: Option<usize>,
+    x0: f64,
+) -> [f64; MAX_INPUTS] {
+    let mut x = *base;
+    if let Some(k) = out {
+        rel.select_output(&mut x, k);
+    }
+    x[0] = x0;
+    x
+}
+
+/// The input that selects the output of a multi-output relation (kb-mu's μ index), if any:
+/// not a predictor, so not an axis.
+fn selector_input(rel: &dyn Relation) -> Option<usize> {
+    if rel.outputs() < 2 {
+        return None;
+    }
+    let mut a = [0.0; MAX_INPUTS];
+    let mut b = [0.0; MAX_INPUTS];
+    rel.select_output(&mut a, 0);
+    rel.select_output(&mut b, 1);
+    (0..MAX_INPUTS).find(|&j| a[j] != b[j])
+}
+
+/// Whether the paper gives every coefficient of the published curve (no line otherwise: a
+/// curve through made-up values would look like the paper's).
+fn published_given(o: &FitOutcome) -> bool {
+    let rel = o.published.as_ref();
+    rel.parameters().iter().all(|s| s.published.is_finite())
+}
+
+fn xs(lo: f64, hi: f64) -> impl Iterator<Item = f64> {
+    (0..=CURVE_POINTS).map(move |k| lo + (hi - lo) * k as f64 / CURVE_POINTS as f64)
+}
+
+fn fmt_num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && !(1e-3..1e5).contains(&a) {
+        format!("{v:.3e}")
+    } else {
+        let s = format!("{v:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+fn thousands(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Cells of one panel of a `grid` figure.
+fn cells(grid: (usize, usize)) -> (usize, usize) {
+    (
+        (DENSITY_CELLS.0 / grid.1).max(8),
+        (DENSITY_CELLS.1 / grid.0).max(8),
+    )
+}
+
+fn grid_for(n: usize) -> (usize, usize) {
+    match n {
+        0 | 1 => (1, 1),
+        2 => (1, 2),
+        3 | 4 => (2, 2),
+        5 | 6 => (2, 3),
+        _ => (n.div_ceil(3), 3),
+    }
+}
+
+/// What a figure with this frame draws of its rows (legend lines and the caption's words).
+fn data_words(
+    frame: &Frame,
+    what: &str,
+    grid: (usize, usize),
+    means: bool,
+) -> (Vec<String>, String) {
+    let n = thousands(frame.len());
+    let groups = frame.groups;
+    if frame.dense() {
+        let (nx, ny) = cells(grid);
+        let mut legend = vec![
+            format!("density of all {n} {what}"),
+            format!("({nx} × {ny} cells per panel;"),
+            "colour: rows per cell, log scale)".to_string(),
+        ];
+        let mut caption = format!(
+            "the density of all {n} {what} (2-D histogram, {nx} × {ny} cells per panel, rows per \
+             cell on a log colour scale; more than {} rows, so no single points)",
+            thousands(MAX_SCATTER_POINTS)
+        );
+        if means && groups.len() > 1 {
+            legend.push(format!("lines: mean per x bin ({MEAN_BINS} bins,"));
+            legend.push(format!("≥ {MIN_MEAN_BIN_ROWS} rows) of each group"));
+            caption.push_str(&format!(
+                ", with each colour group's mean per x bin ({MEAN_BINS} bins, bins of at least \
+                 {MIN_MEAN_BIN_ROWS} rows), {}",
+                groups.describe()
+            ));
+        }
+        (legend, caption)
+    } else {
+        (
+            vec![format!("all {n} {what} as points")],
+            format!("all {n} {what} as points, {}", groups.describe()),
+        )
+    }
+}
+
+fn groups_legend(groups: &Groups) -> Option<(String, Vec<String>)> {
+    (groups.len() > 1 || groups.by != GroupBy::Single).then(|| {
+        let title = match groups.by {
+            GroupBy::Subject => "colour: subject · data set",
+            GroupBy::DataSet => "colour: data set",
+            GroupBy::Single => "one colour",
+        };
+        let labels = groups
+            .labels
+            .iter()
+            .zip(&groups.rows)
+            .map(|(l, r)| format!("{l} ({})", thousands(*r)))
+            .collect();
+        (title.to_string(), labels)
+    })
+}
+
+/// The data figure's sources: one panel per output.
+fn main_sources(rel: &dyn Relation) -> Vec<Source> {
+    let outs: Vec<Option<usize>> = if rel.outputs() > 1 {
+        (0..rel.outputs()).map(Some).collect()
+    } else {
+        vec![None]
+    };
+    outs.into_iter()
+        .map(|output| Source {
+            x: Axis::Input(0),
+            y: Axis::Response,
+            output,
+        })
+        .collect()
+}
+
+/// Builds the data figure (one panel per output), its data layer still empty.
+fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInputs]) -> Spec {
+    let o = frame.o;
     let rel = o.refit.as_ref();
+    let id = &o.record.relation;
+    let n_out = rel.outputs();
     let inputs = rel.inputs();
     let resp = rel.response();
-    let n = o.prepared.obs.len().max(1) as f64;
-    // Other inputs at their means (e.g. body height).
-    let mut mean_x = [0.0; crate::relations::MAX_INPUTS];
-    for obs in &o.prepared.obs {
-        for (m, v) in mean_x.iter_mut().zip(obs.x) {
-            *m += v / n;
+    let sel = selector_input(rel);
+    let outs: Vec<Option<usize>> = sources.iter().map(|s| s.output).collect();
+    let total: usize = gin.iter().map(|g| g.n).sum();
+    let mut mean_x = [0.0; MAX_INPUTS];
+    for g in gin {
+        for (m, v) in mean_x.iter_mut().zip(g.mean) {
+            *m += v * g.n as f64 / total.max(1) as f64;
         }
     }
-    let (xlo, xhi) = o
-        .prepared
-        .obs
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, b| {
-            (a.0.min(b.x[0]), a.1.max(b.x[0]))
+    // Other continuous inputs (body height): curves are drawn at their mean, and per group.
+    let others: Vec<usize> = (1..inputs.len()).filter(|&j| Some(j) != sel).collect();
+    let levels = rel.subject_levels();
+    let per_group =
+        frame.groups.len() > 1 && (!others.is_empty() || rel.subject_effect().is_some());
+    let published = published_given(o);
+    let grid = grid_for(outs.len());
+    let mut panels = Vec::new();
+    for (src, e) in sources.iter().zip(ext) {
+        let out = src.output;
+        let (xlo, xhi) = pad(e.x.0, e.x.1);
+        let mut band = Vec::with_capacity(CURVE_POINTS + 1);
+        let mut refit = Vec::with_capacity(CURVE_POINTS + 1);
+        let mut publ = Vec::new();
+        for x0 in xs(xlo, xhi) {
+            let x = at(rel, &mean_x, out, x0);
+            let (m, lo, hi) = o.band(&x);
+            band.push((x0, lo, hi));
+            refit.push((x0, m));
+            if published {
+                publ.push((x0, o.published.predict(&x)));
+            }
+        }
+        let mut lines = Vec::new();
+        if per_group {
+            for (g, gi) in gin.iter().enumerate() {
+                if gi.n == 0 || gi.x0.1 < gi.x0.0 {
+                    continue;
+                }
+                let level = frame.groups.subject[g]
+                    .and_then(|s| o.prepared.subjects.get(s))
+                    .and_then(|name| levels.get(name))
+                    .copied()
+                    .unwrap_or(0.0);
+                let pts = xs(gi.x0.0, gi.x0.1)
+                    .map(|x0| {
+                        let x = at(rel, &gi.mean, out, x0);
+                        (x0, rel.predict_with(&o.values, level, &x))
+                    })
+                    .collect();
+                lines.push(Line {
+                    pts,
+                    kind: LineKind::GroupCurve(g as u16),
+                });
+            }
+        }
+        lines.push(Line {
+            pts: publ,
+            kind: LineKind::Published,
         });
-    let (xlo, xhi) = pad(xlo, xhi);
-    const K: usize = 200;
-    // One curve per output (kb-mu's four μ-functions), else one at the other inputs' means.
-    let n_out = rel.outputs();
-    // (x, refit, band low, band high, published) per abscissa point.
-    type Curve = Vec<(f64, f64, f64, f64, f64)>;
-    let curves: Vec<Curve> = (0..n_out)
-        .map(|out| {
-            (0..=K)
-                .map(|k| {
-                    let x0 = xlo + (xhi - xlo) * k as f64 / K as f64;
-                    let mut x = mean_x;
-                    if n_out > 1 {
-                        rel.select_output(&mut x, out);
-                    }
-                    x[0] = x0;
-                    let (m, lo, hi) = o.band(&x);
-                    (x0, m, lo, hi, o.published.predict(&x))
-                })
-                .collect()
-        })
-        .collect();
-    let ys = o
-        .prepared
-        .obs
-        .iter()
-        .map(|o| o.y)
-        .chain(curves.iter().flatten().flat_map(|c| [c.1, c.2, c.3, c.4]));
-    let (ylo, yhi) = ys.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| {
-        (a.0.min(y), a.1.max(y))
-    });
-    let (ylo, yhi) = pad(ylo, yhi);
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let others: Vec<String> = inputs
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(j, v)| format!("{} = {:.3} {} (mean)", v.symbol, mean_x[j], v.unit))
-        .collect();
-    let caption = if n_out > 1 {
-        format!(
-            "{} — one curve per output ({})",
-            rel.id(),
-            (0..n_out)
-                .map(|k| rel.output_name(k))
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    } else if others.is_empty() {
-        format!("{} — {}", rel.id(), rel.citation().equation)
-    } else {
-        format!("{} — curves at {}", rel.id(), others.join(", "))
-    };
-    let mut chart = ChartBuilder::on(root)
-        .caption(caption, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xlo..xhi, ylo..yhi)
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("{} ({})", inputs[0].symbol, inputs[0].unit))
-        .y_desc(format!("{} ({})", resp.symbol, resp.unit))
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    let band_color = RGBColor(120, 160, 230).mix(0.35);
-    chart
-        .draw_series(curves.iter().map(|curve| {
-            Polygon::new(
-                curve
-                    .iter()
-                    .map(|c| (c.0, c.3))
-                    .chain(curve.iter().rev().map(|c| (c.0, c.2)))
-                    .collect::<Vec<_>>(),
-                band_color.filled(),
-            )
-        }))
-        .map_err(|e| e.to_string())?
-        .label("refit 95 % band")
-        .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 18, y + 5)], band_color.filled()));
-    chart
-        .draw_series(
-            o.prepared
-                .obs
-                .iter()
-                .map(|ob| Cross::new((ob.x[0], ob.y), 3, BLACK.mix(0.5).stroke_width(1))),
-        )
-        .map_err(|e| e.to_string())?
-        .label(format!("data (n = {})", o.prepared.obs.len()))
-        .legend(|(x, y)| Cross::new((x + 9, y), 4, BLACK));
-    for curve in curves.iter().skip(1) {
-        chart
-            .draw_series(LineSeries::new(
-                curve.iter().map(|c| (c.0, c.1)),
-                BLUE.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(LineSeries::new(
-                curve.iter().map(|c| (c.0, c.4)),
-                RED.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?;
+        lines.push(Line {
+            pts: refit,
+            kind: LineKind::Refit,
+        });
+        let (mut ylo, mut yhi) = e.y;
+        for &(_, lo, hi) in &band {
+            ylo = ylo.min(lo);
+            yhi = yhi.max(hi);
+        }
+        for l in &lines {
+            for &(_, y) in &l.pts {
+                if y.is_finite() {
+                    ylo = ylo.min(y);
+                    yhi = yhi.max(y);
+                }
+            }
+        }
+        let y = pad(ylo, yhi);
+        let y_desc = match out {
+            Some(k) => format!("{} ({})", rel.output_name(k), resp.unit),
+            None => format!("{} ({})", resp.symbol, resp.unit),
+        };
+        panels.push(Panel {
+            source: Some(*src),
+            title: out.map(|k| output_title(rel, k)),
+            x_desc: format!("{} ({})", inputs[0].symbol, inputs[0].unit),
+            y_desc,
+            x: (xlo, xhi),
+            y,
+            data: DataLayer::Points(Vec::new()),
+            band,
+            lines,
+        });
     }
-    let curve = &curves[0];
-    chart
-        .draw_series(LineSeries::new(
-            curve.iter().map(|c| (c.0, c.1)),
-            BLUE.stroke_width(2),
-        ))
-        .map_err(|e| e.to_string())?
-        .label("refit")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLUE.stroke_width(2)));
-    chart
-        .draw_series(LineSeries::new(
-            curve.iter().map(|c| (c.0, c.4)),
-            RED.stroke_width(2),
-        ))
-        .map_err(|e| e.to_string())?
-        .label("published")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .position(SeriesLabelPosition::UpperLeft)
-        .draw()
-        .map_err(|e| e.to_string())?;
-    Ok(())
+    let at_means = others
+        .iter()
+        .map(|&j| {
+            format!(
+                "{} = {} {}",
+                inputs[j].symbol,
+                fmt_num(mean_x[j]),
+                inputs[j].unit
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut lines_legend = vec![(
+        LineKind::Refit,
+        if at_means.is_empty() {
+            "refit".to_string()
+        } else {
+            format!("refit, average subject at {at_means} (mean)")
+        },
+    )];
+    if published {
+        lines_legend.push((LineKind::Published, "published".into()));
+    } else {
+        lines_legend.push((
+            LineKind::Reference,
+            "no published curve: the paper gives no value for some coefficients".into(),
+        ));
+    }
+    if per_group {
+        let who = match frame.groups.by {
+            GroupBy::Subject => "each subject's",
+            _ => "each data set's",
+        };
+        let mut what = format!("{who} refit");
+        if !others.is_empty() {
+            let syms: Vec<&str> = others.iter().map(|&j| inputs[j].symbol).collect();
+            what.push_str(&format!(" at its mean {}", syms.join(", ")));
+        }
+        if rel.subject_effect().is_some() && frame.groups.by == GroupBy::Subject {
+            what.push_str(if others.is_empty() {
+                " with its level"
+            } else {
+                " and its level"
+            });
+        }
+        what.push_str(", over its own range");
+        lines_legend.push((LineKind::GroupCurve(0), what));
+    }
+    let (data_legend, drawn) = data_words(frame, "rows", grid, !per_group);
+    let mut shows = format!(
+        "{} against {} with the refit ({}) and its 95 % confidence band",
+        resp.symbol,
+        inputs[0].symbol,
+        if at_means.is_empty() {
+            "average subject".into()
+        } else {
+            format!("average subject at {at_means}")
+        }
+    );
+    if published {
+        shows.push_str(", and the published curve");
+    } else {
+        shows.push_str("; no published curve (the paper gives no value for some coefficients)");
+    }
+    if per_group {
+        shows.push_str(&format!(
+            "; thin coloured curves: {}",
+            lines_legend.last().map_or("", |l| l.1.as_str())
+        ));
+    }
+    if n_out > 1 {
+        shows.push_str(&format!("; one panel per output ({n_out})"));
+    }
+    let mut title = format!("{id} — {}", rel.citation().equation);
+    if n_out > 1 {
+        title = format!("{id} — one panel per output");
+    }
+    Spec {
+        stem: id.clone(),
+        title,
+        panels,
+        grid,
+        // Group curves already stand for the groups: no binned means over the density.
+        group_means: !per_group,
+        data_legend,
+        groups: groups_legend(frame.groups),
+        density_max: None,
+        lines_legend,
+        shows,
+        drawn,
+    }
 }
 
-fn scatter_plot<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    title: &str,
-    xdesc: &str,
-    ydesc: &str,
-    pts: &[(f64, f64)],
-    reference: Option<(f64, f64)>,
-) -> Result<(), String> {
+/// The label of output `k`'s panel.
+fn output_title(rel: &dyn Relation, k: usize) -> String {
+    rel.output_label(k)
+}
+
+/// The sources of the residual figures: against fitted values, or against each input (one
+/// panel per input and output).
+fn residual_sources(rel: &dyn Relation, against_inputs: bool) -> Vec<Source> {
+    let sel = selector_input(rel);
+    let mut sources = Vec::new();
+    if against_inputs {
+        let outs: Vec<Option<usize>> = if rel.outputs() > 1 {
+            (0..rel.outputs()).map(Some).collect()
+        } else {
+            vec![None]
+        };
+        for out in outs {
+            for j in 0..rel.inputs().len() {
+                if Some(j) != sel {
+                    sources.push(Source {
+                        x: Axis::Input(j),
+                        y: Axis::Residual,
+                        output: out,
+                    });
+                }
+            }
+        }
+    } else {
+        sources.push(Source {
+            x: Axis::Fitted,
+            y: Axis::Residual,
+            output: None,
+        });
+    }
+    sources
+}
+
+/// A residual figure (see [`residual_sources`]), its data layer still empty.
+fn residual_spec(frame: &Frame, sources: &[Source], ext: &[Extent], against_inputs: bool) -> Spec {
+    let o = frame.o;
+    let rel = o.refit.as_ref();
+    let id = &o.record.relation;
+    let resp = rel.response();
+    let grid = grid_for(sources.len());
+    let panels: Vec<Panel> = sources
+        .iter()
+        .zip(ext)
+        .map(|(src, e)| {
+            let x = pad(e.x.0, e.x.1);
+            let y = pad(e.y.0.min(0.0), e.y.1.max(0.0));
+            let x_desc = match src.x {
+                Axis::Input(j) => {
+                    let v = rel.inputs()[j];
+                    format!("{} ({})", v.symbol, v.unit)
+                }
+                _ => format!("fitted {} ({})", resp.symbol, resp.unit),
+            };
+            Panel {
+                source: Some(*src),
+                title: src.output.map(|k| output_title(rel, k)),
+                x_desc,
+                y_desc: format!("residual ({})", resp.unit),
+                x,
+                y,
+                lines: vec![Line {
+                    pts: vec![(x.0, 0.0), (x.1, 0.0)],
+                    kind: LineKind::Reference,
+                }],
+                data: DataLayer::Points(Vec::new()),
+                band: Vec::new(),
+            }
+        })
+        .collect();
+    let (data_legend, drawn) = data_words(frame, "residuals", grid, true);
+    let (stem, title, shows) = if against_inputs {
+        (
+            format!("{id}-residuals-inputs"),
+            format!("{id} — residuals against each input"),
+            "residuals (measured − refit, each row with its subject's level) against each input"
+                .to_string(),
+        )
+    } else {
+        (
+            format!("{id}-residuals"),
+            format!("{id} — residuals against fitted values"),
+            "residuals (measured − refit) against fitted values".to_string(),
+        )
+    };
+    Spec {
+        stem,
+        title,
+        panels,
+        grid,
+        group_means: true,
+        data_legend,
+        groups: groups_legend(frame.groups),
+        density_max: None,
+        lines_legend: {
+            let mut l = vec![(LineKind::Reference, "residual 0".to_string())];
+            if frame.dense() && frame.groups.len() > 1 {
+                l.push((
+                    LineKind::GroupMean(0),
+                    "mean residual per x bin, one line per colour group".into(),
+                ));
+            }
+            l
+        },
+        shows,
+        drawn,
+    }
+}
+
+/// The normal Q–Q plot of the residuals.
+fn qq_spec(frame: &Frame) -> Spec {
+    let o = frame.o;
+    let id = &o.record.relation;
+    let resp = o.refit.response();
+    let q = qq::qq_points(&o.residuals, MAX_SCATTER_POINTS);
+    let (pts, n, mean, sd) = (q.pts, q.n, q.mean, q.sd);
     let (xlo, xhi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
         (a.0.min(p.0), a.1.max(p.0))
     });
     let (ylo, yhi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
         (a.0.min(p.1), a.1.max(p.1))
     });
-    let (xlo, xhi) = pad(xlo, xhi);
-    let (ylo, yhi) = pad(ylo, yhi);
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let mut chart = ChartBuilder::on(root)
-        .caption(title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xlo..xhi, ylo..yhi)
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_mesh()
-        .x_desc(xdesc)
-        .y_desc(ydesc)
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    if let Some((slope, icpt)) = reference {
+    let x = pad(xlo, xhi);
+    let y = pad(ylo.min(mean + sd * xlo), yhi.max(mean + sd * xhi));
+    let all = pts.len() == n;
+    let nn = thousands(n);
+    let (data_legend, drawn) = if all {
+        (
+            vec![format!("all {nn} residuals")],
+            format!("all {nn} residuals as points"),
+        )
+    } else {
+        (
+            vec![
+                format!("{} order statistics of", pts.len()),
+                format!("all {nn} residuals (exact;"),
+                "even in normal quantile,".into(),
+                "min and max included)".into(),
+            ],
+            format!(
+                "{} exact order statistics of all {nn} residuals, at ranks evenly spaced in \
+                 normal quantile (smallest and largest included; more than {} residuals, so \
+                 not every one)",
+                pts.len(),
+                thousands(MAX_SCATTER_POINTS)
+            ),
+        )
+    };
+    let panel = Panel {
+        source: None,
+        title: None,
+        x_desc: "normal quantile".into(),
+        y_desc: format!("residual ({})", resp.unit),
+        x,
+        y,
+        data: DataLayer::Points(pts.into_iter().map(|(a, b)| (a, b, 0)).collect()),
+        band: Vec::new(),
+        lines: vec![Line {
+            pts: vec![(x.0, mean + sd * x.0), (x.1, mean + sd * x.1)],
+            kind: LineKind::Reference,
+        }],
+    };
+    Spec {
+        stem: format!("{id}-qq"),
+        title: format!("{id} — normal Q–Q plot of residuals"),
+        panels: vec![panel],
+        grid: (1, 1),
+        group_means: false,
+        data_legend,
+        groups: None,
+        density_max: None,
+        lines_legend: vec![(
+            LineKind::Reference,
+            format!("normal: mean {}, sd {}", fmt_num(mean), fmt_num(sd)),
+        )],
+        shows: "normal Q–Q plot of the residuals (all subjects pooled), with the normal line \
+                of their mean and standard deviation"
+            .into(),
+        drawn,
+    }
+}
+
+fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
+fn draw_line<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    l: &Line,
+) -> Result<(), String> {
+    let pts: Vec<(f64, f64)> = l.pts.iter().copied().filter(|p| p.1.is_finite()).collect();
+    if pts.len() < 2 {
+        return Ok(());
+    }
+    let (color, width, dashed) = match l.kind {
+        LineKind::Refit => (BLACK, 2, false),
+        LineKind::Published => (PUBLISHED, 2, true),
+        LineKind::GroupCurve(g) => (group_color(g), 2, false),
+        LineKind::GroupMean(g) => (group_color(g), 2, false),
+        LineKind::Reference => (RGBColor(90, 90, 90), 1, true),
+    };
+    // A white halo keeps the fitted curves readable over points and density cells.
+    if matches!(
+        l.kind,
+        LineKind::Refit | LineKind::Published | LineKind::GroupCurve(_)
+    ) {
         chart
             .draw_series(LineSeries::new(
-                [(xlo, icpt + slope * xlo), (xhi, icpt + slope * xhi)],
-                RED.stroke_width(1),
+                pts.iter().copied(),
+                WHITE.stroke_width(width + 2),
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(err)?;
     }
-    chart
-        .draw_series(
-            pts.iter()
-                .map(|&(x, y)| Circle::new((x, y), 2, BLUE.mix(0.6).filled())),
-        )
-        .map_err(|e| e.to_string())?;
+    if dashed {
+        chart
+            .draw_series(DashedLineSeries::new(
+                pts.iter().copied(),
+                8,
+                5,
+                color.stroke_width(width),
+            ))
+            .map_err(err)?;
+    } else {
+        chart
+            .draw_series(LineSeries::new(
+                pts.iter().copied(),
+                color.stroke_width(width),
+            ))
+            .map_err(err)?;
+    }
     Ok(())
 }
 
-/// Writes `<dir>/<id>.{svg,png}`, `<id>-residuals.{svg,png}` and `<id>-qq.{svg,png}`.
-pub fn write_plots(dir: &Path, o: &FitOutcome) -> Result<Vec<PathBuf>, ReportError> {
-    let id = o.record.relation.clone();
-    if o.prepared.obs.is_empty() {
-        return Ok(Vec::new());
-    }
-    let mut out = Vec::new();
-    out.extend(write_pair(
-        &dir.join(&id),
-        |a| main_plot(a, o),
-        |a| main_plot(a, o),
-    )?);
-    let resp = o.refit.response();
-    let rf: Vec<(f64, f64)> = o
-        .fitted
-        .iter()
-        .zip(&o.residuals)
-        .map(|(f, r)| (*f, *r))
-        .collect();
-    let title = format!("{} — residuals vs fitted", id);
-    let xd = format!("fitted {} ({})", resp.symbol, resp.unit);
-    let yd = format!("residual ({})", resp.unit);
-    out.extend(write_pair(
-        &dir.join(format!("{id}-residuals")),
-        |a| scatter_plot(a, &title, &xd, &yd, &rf, Some((0.0, 0.0))),
-        |a| scatter_plot(a, &title, &xd, &yd, &rf, Some((0.0, 0.0))),
-    )?);
-    let mut r = o.residuals.clone();
-    r.sort_by(f64::total_cmp);
-    let n = r.len();
-    let mean = r.iter().sum::<f64>() / n as f64;
-    let sd = (r.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n.max(2) - 1) as f64).sqrt();
-    let qq: Vec<(f64, f64)> = r
-        .iter()
-        .enumerate()
-        .map(|(i, e)| (normal_quantile((i as f64 + 0.5) / n as f64), *e))
-        .collect();
-    let title = format!("{} — normal Q–Q plot of residuals", id);
-    out.extend(write_pair(
-        &dir.join(format!("{id}-qq")),
-        |a| scatter_plot(a, &title, "normal quantile", &yd, &qq, Some((sd, mean))),
-        |a| scatter_plot(a, &title, "normal quantile", &yd, &qq, Some((sd, mean))),
-    )?);
-    Ok(out)
+/// Grey of the emptiest (1 row) and the fullest density cell: light enough that coloured lines
+/// and points read over every cell, dark enough that a lone row shows on white.
+const DENSITY_LIGHT: f64 = 215.0;
+const DENSITY_DARK: f64 = 40.0;
+
+/// The grey of a density cell at position `t` ∈ [0, 1] of the log colour scale.
+fn density_grey(t: f64) -> RGBColor {
+    let v = (DENSITY_LIGHT + (DENSITY_DARK - DENSITY_LIGHT) * t.clamp(0.0, 1.0)).round() as u8;
+    RGBColor(v, v, v)
 }
 
-/// Draws into `<stem>.svg` and `<stem>.png`, both written atomically (temporary file + rename);
-/// two closures because the drawing code is generic over the backend.
-fn write_pair<F, G>(stem: &Path, svg_draw: F, png_draw: G) -> Result<Vec<PathBuf>, ReportError>
-where
-    F: Fn(&DrawingArea<SVGBackend, Shift>) -> Result<(), String>,
-    G: Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<(), String>,
-{
+/// The colour of a density cell with `c` rows when the fullest has `max` (log scale).
+fn density_color(c: u32, max: u32) -> RGBColor {
+    let t = if max > 1 {
+        (c as f64).ln() / (max as f64).ln()
+    } else {
+        1.0
+    };
+    density_grey(t)
+}
+
+fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> Result<(), String> {
+    let mut cb = ChartBuilder::on(area);
+    cb.margin(8).x_label_area_size(42).y_label_area_size(62);
+    if let Some(t) = &p.title {
+        cb.caption(t, (FONT, 15));
+    }
+    let mut chart = cb
+        .build_cartesian_2d(p.x.0..p.x.1, p.y.0..p.y.1)
+        .map_err(err)?;
+    let dx = ticks::decimals(p.x.0, p.x.1, ticks::LABELS);
+    let dy = ticks::decimals(p.y.0, p.y.1, ticks::LABELS);
+    let fx = move |v: &f64| ticks::label(*v, dx);
+    let fy = move |v: &f64| ticks::label(*v, dy);
+    chart
+        .configure_mesh()
+        .x_labels(ticks::LABELS)
+        .y_labels(ticks::LABELS)
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .x_desc(p.x_desc.as_str())
+        .y_desc(p.y_desc.as_str())
+        .label_style((FONT, 13))
+        .axis_desc_style((FONT, 14))
+        .bold_line_style(BLACK.mix(0.10))
+        .light_line_style(BLACK.mix(0.03))
+        .draw()
+        .map_err(err)?;
+    match &p.data {
+        DataLayer::Points(pts) => {
+            chart
+                .draw_series(
+                    pts.iter().map(|&(x, y, g)| {
+                        Circle::new((x, y), 2, group_color(g).mix(0.75).filled())
+                    }),
+                )
+                .map_err(err)?;
+        }
+        DataLayer::Density(d) => {
+            draw_density(&mut chart, d)?;
+        }
+    }
+    if p.band.len() >= 2 {
+        chart
+            .draw_series(std::iter::once(Polygon::new(
+                p.band
+                    .iter()
+                    .map(|c| (c.0, c.2))
+                    .chain(p.band.iter().rev().map(|c| (c.0, c.1)))
+                    .collect::<Vec<_>>(),
+                BAND.mix(0.30).filled(),
+            )))
+            .map_err(err)?;
+        for edge in [
+            p.band.iter().map(|c| (c.0, c.1)).collect::<Vec<_>>(),
+            p.band.iter().map(|c| (c.0, c.2)).collect::<Vec<_>>(),
+        ] {
+            chart
+                .draw_series(LineSeries::new(edge, BAND.mix(0.8).stroke_width(1)))
+                .map_err(err)?;
+        }
+    }
+    if let DataLayer::Density(d) = &p.data {
+        for (g, m) in d.means.iter().enumerate() {
+            draw_line(
+                &mut chart,
+                &Line {
+                    pts: m.clone(),
+                    kind: LineKind::GroupMean(g as u16),
+                },
+            )?;
+            // Markers too: a group at one value of x (one subject's height) has one bin.
+            let c = group_color(g as u16);
+            chart
+                .draw_series(m.iter().map(|&p| Circle::new(p, 3, c.filled())))
+                .map_err(err)?;
+        }
+    }
+    for l in &p.lines {
+        draw_line(&mut chart, l)?;
+    }
+    Ok(())
+}
+
+fn draw_density<DB: DrawingBackend>(
+    chart: &mut ChartContext<
+        DB,
+        Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+    >,
+    d: &Density,
+) -> Result<(), String> {
+    let wx = (d.x.1 - d.x.0) / d.nx as f64;
+    let wy = (d.y.1 - d.y.0) / d.ny as f64;
+    chart
+        .draw_series((0..d.ny).flat_map(|cy| {
+            (0..d.nx).filter_map(move |cx| {
+                let c = d.counts[cy * d.nx + cx];
+                (c > 0).then(|| {
+                    let x0 = d.x.0 + cx as f64 * wx;
+                    let y0 = d.y.0 + cy as f64 * wy;
+                    Rectangle::new(
+                        [(x0, y0), (x0 + wx, y0 + wy)],
+                        density_color(c, d.max).filled(),
+                    )
+                })
+            })
+        }))
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Splits `text` into lines of at most `width` px at font `size`.
+fn wrap(text: &str, size: f64, width: f64) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut cur = String::new();
+    for w in text.split_whitespace() {
+        let cand = if cur.is_empty() {
+            w.to_string()
+        } else {
+            format!("{cur} {w}")
+        };
+        if !cur.is_empty() && raster::text_box(&cand, size).0 > width {
+            out.push(std::mem::replace(&mut cur, w.to_string()));
+        } else {
+            cur = cand;
+        }
+    }
+    if !cur.is_empty() {
+        out.push(cur);
+    }
+    out
+}
+
+fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, s: &Spec) -> Result<(), String> {
+    const FS: f64 = 12.0;
+    const LH: i32 = 15;
+    let (w, _) = area.dim_in_pixel();
+    let text_w = w as f64 - 16.0;
+    let style = (FONT, FS).into_font().color(&BLACK);
+    let bold = (FONT, FS).into_font().style(FontStyle::Bold).color(&BLACK);
+    let mut y = 8;
+    let text = |t: &str, x: i32, y: i32, st: &TextStyle| -> Result<(), String> {
+        area.draw(&Text::new(t.to_string(), (x, y), st.clone()))
+            .map_err(err)
+    };
+    text("data drawn", 6, y, &bold)?;
+    y += LH + 2;
+    for l in &s.data_legend {
+        for line in wrap(l, FS, text_w) {
+            text(&line, 6, y, &style)?;
+            y += LH;
+        }
+    }
+    if let Some(max) = s.density_max {
+        y += 4;
+        let bar_w = (w as i32 - 24).max(40);
+        for k in 0..bar_w {
+            let t = k as f64 / (bar_w - 1) as f64;
+            let c = density_grey(t);
+            area.draw(&Rectangle::new([(8 + k, y), (9 + k, y + 12)], c.filled()))
+                .map_err(err)?;
+        }
+        y += 14;
+        // Ticks at 1 and powers of ten up to the maximum (position ln c / ln max).
+        let mut marks = vec![1u32];
+        let mut p = 10u32;
+        while p < max && marks.len() < 7 {
+            marks.push(p);
+            p = p.saturating_mul(10);
+        }
+        for m in marks
+            .iter()
+            .copied()
+            .chain(std::iter::once(max).filter(|&m| m > 1))
+        {
+            let t = if max > 1 {
+                (m as f64).ln() / (max as f64).ln()
+            } else {
+                0.0
+            };
+            let x = 8 + (t * (bar_w - 1) as f64) as i32;
+            let label = thousands(m as usize);
+            let lw = raster::text_box(&label, 10.0).0 as i32;
+            let last = m == max;
+            // The maximum's label goes below the others when they would overlap.
+            let ly = if last { y + 12 } else { y };
+            let lx = (x - lw / 2).clamp(2, w as i32 - lw - 2);
+            text(&label, lx, ly, &(FONT, 10).into_font().color(&BLACK))?;
+        }
+        y += 28;
+    }
+    if let Some((title, labels)) = &s.groups {
+        y += 6;
+        text(title, 6, y, &bold)?;
+        y += LH + 2;
+        for (g, l) in labels.iter().enumerate() {
+            area.draw(&Rectangle::new(
+                [(8, y + 2), (20, y + 12)],
+                group_color(g as u16).filled(),
+            ))
+            .map_err(err)?;
+            let mut l = l.clone();
+            while raster::text_box(&l, FS).0 > text_w - 20.0 && l.chars().count() > 4 {
+                l.pop();
+                l.pop();
+                l.push('…');
+            }
+            text(&l, 26, y, &style)?;
+            y += LH;
+        }
+    }
+    y += 6;
+    text("lines", 6, y, &bold)?;
+    y += LH + 2;
+    let has_band = s.panels.iter().any(|p| !p.band.is_empty());
+    let mut entries: Vec<(Option<LineKind>, String)> = s
+        .lines_legend
+        .iter()
+        .map(|(k, t)| (Some(*k), t.clone()))
+        .collect();
+    if has_band {
+        entries.insert(1, (None, "refit's 95 % confidence band".into()));
+    }
+    for (kind, t) in entries {
+        let sw = |a: &DrawingArea<DB, Shift>| -> Result<(), String> {
+            let mid = y + 7;
+            match kind {
+                None => a
+                    .draw(&Rectangle::new(
+                        [(8, y + 2), (26, y + 12)],
+                        BAND.mix(0.35).filled(),
+                    ))
+                    .map_err(err),
+                Some(k) => {
+                    let (c, wdt) = match k {
+                        LineKind::Refit => (BLACK, 2),
+                        LineKind::Published => (PUBLISHED, 2),
+                        LineKind::GroupCurve(g) | LineKind::GroupMean(g) => (group_color(g), 2),
+                        LineKind::Reference => (RGBColor(90, 90, 90), 1),
+                    };
+                    a.draw(&PathElement::new(
+                        vec![(8, mid), (26, mid)],
+                        c.stroke_width(wdt),
+                    ))
+                    .map_err(err)
+                }
+            }
+        };
+        sw(area)?;
+        for line in wrap(&t, FS, text_w - 26.0) {
+            text(&line, 32, y, &style)?;
+            y += LH;
+        }
+    }
+    Ok(())
+}
+
+fn draw_spec<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, s: &Spec) -> Result<(), String> {
+    root.fill(&WHITE).map_err(err)?;
+    let body = root.titled(&s.title, (FONT, 19)).map_err(err)?;
+    let (w, _) = body.dim_in_pixel();
+    let (plots, legend) = body.split_horizontally(w.saturating_sub(LEGEND_W));
+    for (area, p) in plots.split_evenly(s.grid).iter().zip(&s.panels) {
+        draw_panel(area, p)?;
+    }
+    draw_legend(&legend, s)
+}
+
+fn with_density_max(mut s: Spec) -> Spec {
+    s.density_max = s
+        .panels
+        .iter()
+        .filter_map(|p| match &p.data {
+            DataLayer::Density(d) => Some(d.max),
+            DataLayer::Points(_) => None,
+        })
+        .max();
+    // One colour scale for all panels: each panel's cells are coloured by the figure's max.
+    if let Some(m) = s.density_max {
+        for p in &mut s.panels {
+            if let DataLayer::Density(d) = &mut p.data {
+                d.max = m;
+            }
+        }
+    }
+    s
+}
+
+/// The figures of one fit, reduced (no drawing yet): two passes over the rows for all figures
+/// (extents; then points or density cells), plus the Q–Q plot's passes over the residuals.
+fn specs(o: &FitOutcome) -> Vec<Spec> {
+    let rel = o.refit.as_ref();
+    let groups = Groups::new(&o.prepared);
+    let frame = Frame::new(o, &groups);
+    let src = [
+        main_sources(rel),
+        residual_sources(rel, false),
+        residual_sources(rel, true),
+    ];
+    let all: Vec<Source> = src.iter().flatten().copied().collect();
+    let (ext, gin) = frame.extents(&all);
+    let (e0, rest) = ext.split_at(src[0].len());
+    let (e1, e2) = rest.split_at(src[1].len());
+    let mut specs = vec![
+        main_spec(&frame, &src[0], e0, &gin),
+        residual_spec(&frame, &src[1], e1, false),
+        residual_spec(&frame, &src[2], e2, true),
+    ];
+    let mut sources = Vec::new();
+    let mut ranges = Vec::new();
+    let mut cells_of = Vec::new();
+    for s in &specs {
+        for p in &s.panels {
+            if let Some(src) = p.source {
+                sources.push(src);
+                ranges.push((p.x, p.y));
+                cells_of.push(cells(s.grid));
+            }
+        }
+    }
+    let mut layers = frame.layers(&sources, &ranges, &cells_of).into_iter();
+    for s in &mut specs {
+        let means = s.group_means;
+        for p in s.panels.iter_mut().filter(|p| p.source.is_some()) {
+            if let Some(mut d) = layers.next() {
+                if let (DataLayer::Density(den), false) = (&mut d, means) {
+                    den.means.iter_mut().for_each(Vec::clear);
+                }
+                p.data = d;
+            }
+        }
+    }
+    specs.push(qq_spec(&frame));
+    specs.into_iter().map(with_density_max).collect()
+}
+
+/// Draws `s` into `<dir>/<stem>.svg` and `.png`, each written atomically.
+fn write_spec(dir: &Path, s: &Spec) -> Result<Vec<PathBuf>, ReportError> {
     register_font();
-    let svg_path = stem.with_extension("svg");
+    let svg_path = dir.join(format!("{}.svg", s.stem));
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (W, H)).into_drawing_area();
-        svg_draw(&root).map_err(|e| perr(&svg_path, e))?;
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        draw_spec(&root, s).map_err(|e| perr(&svg_path, e))?;
         root.present().map_err(|e| perr(&svg_path, e))?;
     }
     write_atomic_bytes(&svg_path, svg.as_bytes())?;
-    let png_path = stem.with_extension("png");
-    let dir = png_path.parent().unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| perr(dir, e))?;
-    let tmp = tempfile::Builder::new()
-        .prefix(".gaitfit-tmp-")
-        .suffix(".png")
-        .tempfile_in(dir)
-        .map_err(|e| perr(&png_path, e))?;
-    {
-        let root = BitMapBackend::new(tmp.path(), (W, H)).into_drawing_area();
-        png_draw(&root).map_err(|e| perr(&png_path, e))?;
-        root.present().map_err(|e| perr(&png_path, e))?;
-    }
-    tmp.persist(&png_path)
-        .map_err(|e| perr(&png_path, e.error))?;
+    let png_path = dir.join(format!("{}.png", s.stem));
+    let png =
+        raster::render_png(SIZE, |root| draw_spec(root, s)).map_err(|e| perr(&png_path, e))?;
+    write_atomic_bytes(&png_path, &png)?;
     Ok(vec![svg_path, png_path])
+}
+
+/// Writes the figures of `o` (see the module docs) into `dir`; returns the files written and a
+/// caption per figure. Nothing is written for a fit without rows.
+pub fn write_plots(dir: &Path, o: &FitOutcome) -> Result<(Vec<PathBuf>, Vec<Figure>), ReportError> {
+    use rayon::prelude::*;
+    if o.prepared.obs.is_empty() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let specs = specs(o);
+    let files = specs
+        .par_iter()
+        .map(|s| write_spec(dir, s))
+        .collect::<Result<Vec<_>, _>>()?;
+    let figures = specs
+        .iter()
+        .map(|s| Figure {
+            stem: s.stem.clone(),
+            shows: s.shows.clone(),
+            drawn: s.drawn.clone(),
+        })
+        .collect();
+    Ok((files.into_iter().flatten().collect(), figures))
 }

@@ -1,6 +1,9 @@
 //! `reports/summary.md`: one section per relation — published vs refit coefficients with their
-//! confidence intervals, r² (saying which), rmse, n, validation errors, notes and the plots.
+//! confidence intervals, r² (saying which), rmse, n, validation errors, notes and the plots, each
+//! captioned with what of the data it draws.
+use super::Figure;
 use crate::export::coeffs::FitRecord;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 
 fn g(v: f64) -> String {
@@ -22,7 +25,13 @@ fn go(v: Option<f64>) -> String {
 
 /// Renders the summary of `records` (in the given order). `failures` lists relations that could
 /// not be fitted, with the reason.
-pub fn render_summary(records: &[FitRecord], failures: &[(String, String)]) -> String {
+/// `figures` holds, per relation id, the plots written for it (see
+/// [`super::plots::write_plots`]).
+pub fn render_summary(
+    records: &[FitRecord],
+    failures: &[(String, String)],
+    figures: &BTreeMap<String, Vec<Figure>>,
+) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# gaitfit — refit of the published gait relations\n");
     let _ = writeln!(
@@ -95,16 +104,19 @@ pub fn render_summary(records: &[FitRecord], failures: &[(String, String)]) -> S
         );
         let _ = writeln!(s, "|---|---|---:|---:|---:|---|---:|---|");
         for c in &r.coefficients {
-            let mut note = String::new();
+            // The cell's parts are separate statements: joined with "; " (a bare concatenation
+            // once read "no standard error**bound active**").
+            let mut parts: Vec<String> = Vec::new();
             if let Some(h) = &c.held {
-                note.push_str(h);
+                parts.push(h.clone());
             }
             if let Some(f) = &c.flag {
-                note.push_str(&format!("**{f}**"));
+                parts.push(format!("**{f}**"));
             }
             if let Some(b) = c.ci95_bootstrap {
-                note.push_str(&format!(" boot [{}, {}]", g(b[0]), g(b[1])));
+                parts.push(format!("boot [{}, {}]", g(b[0]), g(b[1])));
             }
+            let note = parts.join("; ");
             let _ = writeln!(
                 s,
                 "| `{}` | {} | {} | {} | {} | [{}, {}] | {} | {} |",
@@ -192,11 +204,24 @@ pub fn render_summary(records: &[FitRecord], failures: &[(String, String)]) -> S
                 let _ = writeln!(s, "- {n}");
             }
         }
-        let _ = writeln!(
-            s,
-            "\n![{id}]({id}.svg)\n\n![{id} residuals]({id}-residuals.svg) ![{id} Q–Q]({id}-qq.svg)",
-            id = r.relation
-        );
+        if let Some(figs) = figures.get(&r.relation) {
+            write_figures(&mut s, figs);
+        }
     }
     s
+}
+
+/// The plots of one relation: each image with a caption saying what it shows and what of the
+/// data is drawn (all rows, or their density).
+fn write_figures(s: &mut String, figs: &[Figure]) {
+    let _ = writeln!(s, "\nPlots (SVG; a PNG of each beside it):");
+    for f in figs {
+        let _ = writeln!(
+            s,
+            "\n![{stem}]({stem}.svg)\n\n*`{stem}.svg`: {}. Drawn: {}.*",
+            f.shows,
+            f.drawn,
+            stem = f.stem
+        );
+    }
 }
