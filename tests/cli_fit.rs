@@ -103,7 +103,7 @@ fn fit_check_export_round_trip() {
             t["n"].as_integer().unwrap() as u64,
             v["n"].as_u64().unwrap()
         );
-        for suffix in ["", "-residuals", "-qq"] {
+        for suffix in ["", "-residuals", "-residuals-inputs", "-qq"] {
             for ext in ["svg", "png"] {
                 let p = d.join(format!("reports/{id}{suffix}.{ext}"));
                 assert!(
