@@ -12,7 +12,7 @@ use crate::generator::running::equations::RunRelations;
 use crate::generator::running::params::{
     default_mass, HEIGHT_RANGE as RUN_HEIGHT_RANGE, LEVEL_RANGE, SF_SEARCH, SPEED_RANGE,
 };
-use crate::generator::walking::{WalkAttributes, ATTRIBUTES};
+use crate::generator::walking::{WalkAttributes, WalkOptions, ATTRIBUTES};
 use serde::Serialize;
 
 /// Speed control, km/h (the papers quote speeds in km/h).
@@ -247,7 +247,10 @@ pub fn walk_controls(p: &ParamValues, attrs: &WalkAttributes) -> Vec<Control> {
     out.push(
         Control::new(MASS, "body", "body mass", "kg", MASS_RANGE_KG)
             .doc("the dynamics' segment masses and inertias (table B-1)")
-            .value(p.mass_kg.unwrap_or(75.0), 75.0),
+            .value(
+                p.mass_kg.unwrap_or(WalkOptions::default().mass_kg),
+                WalkOptions::default().mass_kg,
+            ),
     );
     let defaults = WalkAttributes::default();
     for spec in ATTRIBUTES {
@@ -328,7 +331,14 @@ fn locomotion_controls(p: &ParamValues, a: &WalkAttributes, klaw: bool) -> Vec<C
             .value(p.step_freq_steps_per_min, f64::NAN),
         Control::new(HEIGHT, "body", "body height", "m", height_range(false))
             .doc("table B-1 proportions")
-            .value(h, if klaw { 1.8 } else { 1.75 }),
+            .value(
+                h,
+                if klaw {
+                    WalkOptions::default().height_m
+                } else {
+                    1.75
+                },
+            ),
     ]
 }
 

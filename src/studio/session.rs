@@ -522,12 +522,14 @@ fn walk(req: &StudioRequest, src: &Sources) -> Result<Generated, StudioError> {
         RelationsChoice::Published => WalkRelations::published(),
         RelationsChoice::Refit => WalkRelations::from_fits_dir(&src.fits)?,
     };
+    // KLAW's own defaults (body, frame rate) where the page sends nothing.
+    let klaw = WalkOptions::default();
     let opts = WalkOptions {
-        height_m: req.values.get(HEIGHT).copied().unwrap_or(1.8),
-        mass_kg: req.values.get(MASS).copied().unwrap_or(75.0),
+        height_m: req.values.get(HEIGHT).copied().unwrap_or(klaw.height_m),
+        mass_kg: req.values.get(MASS).copied().unwrap_or(klaw.mass_kg),
         attributes,
         relations: relations.clone(),
-        fps: req.fps.unwrap_or(100.0),
+        fps: req.fps.unwrap_or(klaw.fps),
         start_from_rest: req.from_rest,
         stop: req.stop
             || req
