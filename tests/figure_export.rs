@@ -53,7 +53,7 @@ fn synthetic(frames: usize, spin: bool) -> Motion {
 fn bvh_name(l: Landmark) -> Option<String> {
     Some(match l {
         Landmark::LHeel | Landmark::RHeel | Landmark::LBall | Landmark::RBall => return None,
-        Landmark::Head => "head_end".into(),
+        Landmark::Vertex => "head_end".into(),
         Landmark::LHand => "l_wrist_end".into(),
         Landmark::RHand => "r_wrist_end".into(),
         Landmark::LToe => "l_metatarsal_end".into(),
@@ -221,7 +221,7 @@ fn csv_and_events_round_trip_through_the_dispatcher() {
         "r_heel_y_m",
         "l_ball_x_m",
         "r_toe_z_m",
-        "head_y_m",
+        "vertex_y_m",
         "l_wrist_x_m",
         "l_contact",
         "r_contact",

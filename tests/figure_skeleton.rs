@@ -27,7 +27,7 @@ fn rest_pose_stands_on_the_ground_and_is_body_height_tall() {
                 );
             }
         }
-        assert!((lm[Landmark::Head.index()].y - h).abs() < 1e-12);
+        assert!((lm[Landmark::Vertex.index()].y - h).abs() < 1e-12);
         // Nothing is below the ground and the left side is at −z.
         assert!(lm.iter().all(|p| p.y > -1e-12));
         assert!(lm[Landmark::LHip.index()].z < 0.0 && lm[Landmark::RHip.index()].z > 0.0);
@@ -112,7 +112,7 @@ fn fk_of_a_turned_and_tilted_pose_matches_hand_computation() {
     let lumbar = DVec3::new(0.0, hh + a.pelvis_to_lumbar_m, 0.0);
     let up = a.standing_height_m() - lumbar.y;
     let vertex = lumbar + up * DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0);
-    assert!(near(lm[Landmark::Head.index()], vertex, 1e-12));
+    assert!(near(lm[Landmark::Vertex.index()], vertex, 1e-12));
 }
 
 #[test]

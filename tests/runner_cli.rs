@@ -102,7 +102,7 @@ fn exports_bvh_csv_events_and_trc() {
     // then joint angles in degrees.
     let (head, rows) = read_csv(&dir.path().join("run.csv"));
     assert_eq!(head[0], "time_s");
-    let mut want = vec!["pelvis".to_string(), "head".to_string()];
+    let mut want = vec!["pelvis".to_string(), "vertex".to_string()];
     for s in ["l", "r"] {
         for l in ["hip", "knee", "ankle", "heel", "ball", "toe", "wrist"] {
             want.push(format!("{s}_{l}"));
@@ -133,7 +133,7 @@ fn exports_bvh_csv_events_and_trc() {
     // z to the right: the right hip lies at +z of the left; y up; x forward over the run.
     let r0 = &rows[0];
     assert!(r0[pos("r_hip_z_m")] > r0[pos("l_hip_z_m")]);
-    assert!(r0[pos("head_y_m")] > 1.5);
+    assert!(r0[pos("vertex_y_m")] > 1.5);
     assert!(rows.last().unwrap()[pos("pelvis_x_m")] > r0[pos("pelvis_x_m")] + 3.0);
     // Contacts are 0/1; there are flight frames (both 0).
     assert!(rows

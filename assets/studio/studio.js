@@ -316,7 +316,7 @@
       prints.push({ x: f.xyz[k], z: f.xyz[k + 2], side: e.side });
     }
     let headMax = 0;
-    const head = f.landmarks.indexOf('head');
+    const head = f.landmarks.indexOf('vertex');
     for (let i = 0; i < Math.min(f.frames, 50); i++) headMax = Math.max(headMax, f.xyz[(i * n + head) * 3 + 1]);
     fig = Object.assign({}, f, { n, prints, height: headMax || 1.8 });
     let digest = 0;
@@ -371,7 +371,7 @@
       }
     }
     g.globalAlpha = 1;
-    const head = P(i, fig.landmarks.indexOf('head')), neck = P(i, fig.landmarks.indexOf('neck'));
+    const head = P(i, fig.landmarks.indexOf('vertex')), neck = P(i, fig.landmarks.indexOf('neck'));
     const r = Math.max(4, Math.hypot(head[0] - neck[0], head[1] - neck[1]) * s * 0.32);
     g.strokeStyle = COL.mid; g.lineWidth = 2;
     g.beginPath(); g.arc(X(head[0]), Y(head[1]) + r, r, 0, 2 * Math.PI); g.stroke();

@@ -51,7 +51,16 @@
 //! **Landmarks** ([`Landmark`]): points fixed to a segment, including joint centres and the foot's
 //! sole points `heel` (under and behind the ankle), `ball` (on the sole under the metatarsal joint,
 //! carried by the toe segment, so it stays fixed while the foot rolls about the metatarsal joint
-//! with the toes flat) and `toe` (toe tip, end of the toe segment). `head` is the vertex.
+//! with the toes flat) and `toe` (toe tip, end of the toe segment); `vertex` is the top of the
+//! head.
+//!
+//! **One vocabulary.** A name means one point in every file gaitfit writes: a landmark that is a
+//! joint centre has the joint's name (`l_knee` is the BVH joint, the CSV columns `l_knee_*_m` and
+//! the TRC marker), and points that differ have different names (`head` is the C1 joint, `vertex`
+//! the top of the head 0.13 × height above it; `l_metatarsal` is the joint centre, `l_ball` the
+//! sole point under it). The table of every name, its point and the formats that carry it is in
+//! the README ("Names of points and joints"); `tests/figure_vocabulary.rs` checks it against
+//! [`Joint::ALL`] and [`Landmark::ALL`].
 use super::anthropometry::Anthropometry;
 use super::GenerateError;
 use crate::events::Side;
@@ -302,8 +311,8 @@ pub enum Landmark {
     LToe,
     /// Right toe tip.
     RToe,
-    /// Vertex (top of the head).
-    Head,
+    /// Vertex: the top of the head (the end site of the `head` joint, which is C1).
+    Vertex,
     /// C7/T1 joint centre.
     Neck,
     /// Left shoulder joint centre.
@@ -340,7 +349,7 @@ impl Landmark {
         Landmark::RBall,
         Landmark::LToe,
         Landmark::RToe,
-        Landmark::Head,
+        Landmark::Vertex,
         Landmark::Neck,
         Landmark::LShoulder,
         Landmark::RShoulder,
@@ -373,7 +382,7 @@ impl Landmark {
             Landmark::RBall => "r_ball",
             Landmark::LToe => "l_toe",
             Landmark::RToe => "r_toe",
-            Landmark::Head => "head",
+            Landmark::Vertex => "vertex",
             Landmark::Neck => "neck",
             Landmark::LShoulder => "l_shoulder",
             Landmark::RShoulder => "r_shoulder",
@@ -727,7 +736,7 @@ impl Skeleton {
             }
         }
         landmark_attach[Landmark::Pelvis.index()] = (Joint::Pelvis, DVec3::ZERO);
-        landmark_attach[Landmark::Head.index()] = (Joint::Head, y(a.head_to_vertex_m));
+        landmark_attach[Landmark::Vertex.index()] = (Joint::Head, y(a.head_to_vertex_m));
         landmark_attach[Landmark::Neck.index()] = (Joint::Neck, DVec3::ZERO);
         Ok(Skeleton {
             anthropometry,

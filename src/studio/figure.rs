@@ -26,7 +26,7 @@ pub const BONES: [(Landmark, Landmark); 24] = [
     (Landmark::LBall, Landmark::LToe),
     (Landmark::RBall, Landmark::RToe),
     (Landmark::Pelvis, Landmark::Neck),
-    (Landmark::Neck, Landmark::Head),
+    (Landmark::Neck, Landmark::Vertex),
     (Landmark::Neck, Landmark::LShoulder),
     (Landmark::Neck, Landmark::RShoulder),
     (Landmark::LShoulder, Landmark::LElbow),
