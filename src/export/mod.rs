@@ -1,8 +1,10 @@
-//! Writers: coefficient tables (JSON, TOML, Rust, CSV) and motion files (BVH, CSV, TRC).
+//! Writers: coefficient tables (JSON, TOML, Rust, CSV) and motion files (BVH, CSV, TRC, OpenSim
+//! MOT/STO).
 pub mod bvh;
 pub mod coeffs;
 pub mod motion;
 pub mod motion_csv;
+pub mod opensim;
 pub mod trc;
 
 use thiserror::Error;

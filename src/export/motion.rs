@@ -13,6 +13,11 @@ pub enum MotionFormat {
     Csv,
     /// OpenSim marker file (`.trc`), see [`super::trc`].
     Trc,
+    /// OpenSim motion (`.mot`): joint angles as the gait models' coordinates, see
+    /// [`super::opensim`].
+    Mot,
+    /// OpenSim storage (`.sto`): the same content as `.mot`.
+    Sto,
 }
 
 impl MotionFormat {
@@ -27,13 +32,16 @@ impl MotionFormat {
             "bvh" => Ok(MotionFormat::Bvh),
             "csv" => Ok(MotionFormat::Csv),
             "trc" => Ok(MotionFormat::Trc),
+            "mot" => Ok(MotionFormat::Mot),
+            "sto" => Ok(MotionFormat::Sto),
             _ => {
                 Err(ExportError::Format {
                     path: path.display().to_string(),
                     message: format!(
                     "unknown motion file extension {:?}: use .bvh (Blender and other animation \
                      tools), .csv (landmarks, contacts and joint angles; events go to \
-                     <stem>_events.csv) or .trc (OpenSim markers)",
+                     <stem>_events.csv), .trc (OpenSim markers) or .mot/.sto (OpenSim joint \
+                     angles)",
                     if ext.is_empty() { "(none)".to_string() } else { format!(".{ext}") }
                 ),
                 })
@@ -47,15 +55,18 @@ impl MotionFormat {
 pub struct MotionOptions {
     /// Length unit of a BVH file (metres by default).
     pub bvh_unit: super::bvh::BvhUnit,
+    /// Coordinate conventions of a `.mot`/`.sto` file (gait2392 by default).
+    pub opensim_model: super::opensim::OpenSimModel,
 }
 
-/// Writes `motion` to `path` in the format its extension names (`.bvh`, `.csv`, `.trc`); a CSV
-/// also writes its events to `<stem>_events.csv` next to it. Files are written atomically.
+/// Writes `motion` to `path` in the format its extension names (`.bvh`, `.csv`, `.trc`, `.mot`,
+/// `.sto`); a CSV also writes its events to `<stem>_events.csv` next to it. Files are written
+/// atomically.
 pub fn write(motion: &Motion, path: &Path) -> Result<(), ExportError> {
     write_with(motion, path, &MotionOptions::default())
 }
 
-/// [`write`] with options.
+/// [`write()`] with options.
 pub fn write_with(motion: &Motion, path: &Path, opts: &MotionOptions) -> Result<(), ExportError> {
     match MotionFormat::from_path(path)? {
         MotionFormat::Bvh => super::bvh::write(
@@ -70,5 +81,12 @@ pub fn write_with(motion: &Motion, path: &Path, opts: &MotionOptions) -> Result<
             super::motion_csv::write_events(motion, &super::motion_csv::events_path(path))
         }
         MotionFormat::Trc => super::trc::write(motion, path, &super::trc::TrcOptions::default()),
+        MotionFormat::Mot | MotionFormat::Sto => super::opensim::write(
+            motion,
+            path,
+            &super::opensim::MotOptions {
+                model: opts.opensim_model,
+            },
+        ),
     }
 }

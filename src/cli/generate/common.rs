@@ -5,6 +5,7 @@
 //! units (all through [`crate::units::parse_value`]).
 use crate::export::bvh::BvhUnit;
 use crate::export::motion::MotionOptions;
+use crate::export::opensim::OpenSimModel;
 use crate::generator::motion::Motion;
 use crate::ingest::trials::StepRow;
 use crate::units::{parse_value, Dimension};
@@ -52,6 +53,10 @@ pub struct Common {
     /// Length unit of a BVH output: m (Blender's default import scale) or cm (MotionBuilder).
     #[arg(long = "bvh-units", value_name = "UNIT", default_value = "m", value_parser = bvh_units_arg)]
     pub bvh_units: BvhUnit,
+    /// Coordinate conventions of a `.mot`/`.sto` output: gait2392 (also gait2354 and Hamner
+    /// 2010; knee flexion negative) or rajagopal (Rajagopal 2015; knee flexion positive).
+    #[arg(long = "opensim-model", value_name = "MODEL", default_value = "gait2392", value_parser = opensim_model_arg)]
+    pub opensim_model: OpenSimModel,
     /// Output file: `.bvh`, `.csv` (plus `<stem>_events.csv`), `.trc` (OpenSim markers) or
     /// `.mot`/`.sto` (OpenSim joint angles).
     #[arg(short = 'o', long, value_name = "FILE")]
@@ -76,6 +81,7 @@ impl Common {
         let out = self.output()?;
         let opts = MotionOptions {
             bvh_unit: self.bvh_units,
+            opensim_model: self.opensim_model,
         };
         crate::export::motion::write_with(motion, out, &opts)?;
         Ok(out)
@@ -147,6 +153,14 @@ fn bvh_units_arg(text: &str) -> Result<BvhUnit, String> {
         "m" | "metres" | "meters" => Ok(BvhUnit::Metres),
         "cm" | "centimetres" | "centimeters" => Ok(BvhUnit::Centimetres),
         _ => Err(format!("{text:?}: use m or cm")),
+    }
+}
+
+fn opensim_model_arg(text: &str) -> Result<OpenSimModel, String> {
+    match text.trim().to_ascii_lowercase().as_str() {
+        "gait2392" | "gait2354" | "hamner" | "hamner2010" => Ok(OpenSimModel::Gait2392),
+        "rajagopal" | "rajagopal2015" => Ok(OpenSimModel::Rajagopal2015),
+        _ => Err(format!("{text:?}: use gait2392 or rajagopal")),
     }
 }
 
