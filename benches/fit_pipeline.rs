@@ -20,10 +20,10 @@ use std::io::Write;
 use std::time::{Duration, Instant};
 
 /// A compact trials CSV (only the columns the four relations use, 6 significant digits).
-fn write_csv(path: &std::path::Path, rows: usize) {
+fn write_csv(path: &std::path::Path, rows: usize, subjects: usize) {
     let data = synthetic_rows(&SyntheticSpec {
         rows,
-        subjects: 10,
+        subjects,
         seed: 42,
         ..Default::default()
     });
@@ -100,12 +100,16 @@ fn bench(c: &mut Criterion) {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1_000_000);
+    let subjects: usize = std::env::var("GAITFIT_BENCH_SUBJECTS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10);
     let dir = tempfile::tempdir().expect("tempdir");
     // GAITFIT_BENCH_CSV=<path> keeps the generated table there (to diff fits across versions).
     let path = std::env::var_os("GAITFIT_BENCH_CSV")
         .map(std::path::PathBuf::from)
         .unwrap_or_else(|| dir.path().join("trials.csv"));
-    write_csv(&path, rows);
+    write_csv(&path, rows, subjects);
     let rels = rels();
     let opts = FitOptions::default();
 

@@ -131,10 +131,21 @@ fn fit_check_export_round_trip() {
         .unwrap();
     assert_eq!(bad.status.code(), Some(1));
     let err = String::from_utf8_lossy(&bad.stderr);
+    // The gate is the centred r²: the fit through the origin (walk-sl-sf, uncentred r² ≈ 1)
+    // is below the bar on it (issue 18).
     assert!(
         err.contains("run-tflight-sf")
             && err.contains("walk-tds-sf")
-            && !err.contains("walk-sl-sf"),
+            && err.contains("walk-sl-sf (centred"),
+        "{err}"
+    );
+    let unc = gaitfit(d)
+        .args(["check", "--fits", "fits", "--min-r2", "0.95", "--uncentred"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&unc.stderr);
+    assert!(
+        err.contains("walk-tds-sf") && !err.contains("walk-sl-sf"),
         "{err}"
     );
 

@@ -214,7 +214,10 @@ fn reports_an_active_bound_on_either_side() {
 fn committed_fit_is_the_default_and_winter_leg_length_matches() {
     let path = root().join("fits/kb-mu.json");
     let r = KbMu::from_fit_file(&path).unwrap();
-    assert_eq!(r.alpha(), DEFAULT_ALPHA);
+    // To the last digits a refit's solver may move (the fit solves normal equations).
+    for (a, d) in r.alpha().iter().zip(DEFAULT_ALPHA) {
+        assert!((a - d).abs() <= 1e-12 * d.abs().max(1e-300), "{a} vs {d}");
+    }
     let t = load_tables(&[root().join("data/walk_bmclab.csv")], None).unwrap();
     let ll = t[0].columns[gaitfit::units::Quantity::LegLength as usize]
         .as_ref()

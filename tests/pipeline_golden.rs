@@ -2,6 +2,7 @@
 //! hash, same rows, coefficients and statistics to 1e-9 relative). After regenerating `data/` or
 //! changing the fit, run `cargo run --release -- fit` and commit `fits/` and `reports/`.
 use gaitfit::export::coeffs::read_fits_dir;
+use gaitfit::fit::inference::SeMethod;
 use gaitfit::fit::pipeline::{fit_relation, load_tables, FitOptions};
 use gaitfit::relations::by_id;
 use std::path::{Path, PathBuf};
@@ -51,6 +52,15 @@ fn refitting_bundled_data_reproduces_committed_fits() {
             weights: committed.weights.clone(),
             bootstrap: committed.bootstrap.as_ref().map_or(0, |b| b.n),
             seed: committed.bootstrap.as_ref().map_or(0, |b| b.seed),
+            se: committed
+                .inference
+                .as_ref()
+                .and_then(|i| match i.method.as_str() {
+                    "iid" => Some(SeMethod::Iid),
+                    "CR1" => Some(SeMethod::Cluster),
+                    "CR2" => Some(SeMethod::Cr2),
+                    _ => None,
+                }),
         };
         let now = fit_relation(rel.as_ref(), &tables, &opts).unwrap().record;
         assert_eq!(now.n, committed.n, "{}", committed.relation);

@@ -1,6 +1,7 @@
 //! Every fit's coefficients against an independent least-squares computation (closed-form or
 //! normal equations written out here, in a basis of the test's own choosing), to 1e-9 relative.
 #![allow(clippy::needless_range_loop)]
+use gaitfit::fit::inference::SeMethod;
 use gaitfit::fit::pipeline::{fit_relation, FitOptions};
 use gaitfit::fit::synthetic::{synthetic_rows, SyntheticSpec};
 use gaitfit::ingest::trials::TrialsTable;
@@ -53,7 +54,11 @@ fn walk_sl_sf_is_the_closed_form_slope_through_the_origin() {
         ..Default::default()
     });
     let rel = WalkSlSf::published();
-    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
+    let iid = FitOptions {
+        se: Some(SeMethod::Iid),
+        ..FitOptions::default()
+    };
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &iid).unwrap();
     let d = data_of(&rel, &t);
     let (sxy, sxx, syy) = d.iter().fold((0.0, 0.0, 0.0), |a, (x, y, _)| {
         let z = x[0] * x[1];
@@ -84,7 +89,11 @@ fn walk_tds_sf_is_the_closed_form_simple_regression() {
         ..Default::default()
     });
     let rel = WalkTdsSf::published();
-    let o = fit_relation(&rel, std::slice::from_ref(&t), &FitOptions::default()).unwrap();
+    let iid = FitOptions {
+        se: Some(SeMethod::Iid),
+        ..FitOptions::default()
+    };
+    let o = fit_relation(&rel, std::slice::from_ref(&t), &iid).unwrap();
     let d = data_of(&rel, &t);
     let n = d.len() as f64;
     let mx = d.iter().map(|v| v.0[0]).sum::<f64>() / n;

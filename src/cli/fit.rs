@@ -1,11 +1,17 @@
 //! `gaitfit fit`: refit the published relations on trials tables → `fits/` and `reports/`.
 use crate::export::coeffs::write_fit_files;
+use crate::fit::inference::{SeMethod, CR2_RECOMMENDED_BELOW};
 use crate::fit::pipeline::{fit_all, load_tables, FitOptions};
 use crate::relations::{by_id, registry, Relation};
 use anyhow::Context;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+
+/// Bootstrap replicates of the bundled refit (`gaitfit fit` without `--data`): enough that the
+/// percentile intervals' Monte Carlo error (a few percent of their width) is small beside the
+/// differences between methods they are compared with.
+pub const BUNDLED_BOOTSTRAP: usize = 2000;
 
 /// Arguments of `gaitfit fit`.
 #[derive(Debug, clap::Args)]
@@ -26,6 +32,14 @@ leave-one-subject-out errors, the published coefficients' fit on the same rows, 
 reports/ (per relation: data with refit curve, 95 % band and published curve; residuals vs \
 fitted; normal Q–Q; summary.md). Files are replaced atomically; a relation that fails to fit \
 leaves its existing fits/ files untouched and makes the command exit 1.\n\n\
+Inference: gait rows are repeated measures (many steps per subject), so with two or more \
+subjects standard errors are clustered by subject: CR1 exactly as statsmodels \
+cov_type='cluster' (small-sample factor G/(G−1)·(n−1)/(n−K)), t-tests and intervals with G − 1 \
+degrees of freedom. With fewer than 20 subjects `--se cr2` is recommended: CR1 over-rejects \
+with few or unbalanced clusters, while CR2 (Bell & McCaffrey 2002) with Satterthwaite degrees \
+of freedom keeps close to the nominal level (Imbens & Kolesár 2016; Pustejovsky & Tipton 2018). \
+Each fit record states its method. Breakpoints get the F-based profile confidence set over every \
+admissible value (its pieces and hull); only a regular profile gives them a standard error.\n\n\
 Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf, kb-mu \
 (Ko & Badler 1993 eqs. 21–24: one observation per μ-function and row, α bounds enforced; r² is \
 pooled with each μ centred on its own mean; per-μ statistics are listed as derived).",
@@ -54,15 +68,45 @@ pub struct Args {
     /// Weighted least squares with weights (inverse variances, > 0) from this column.
     #[arg(long, value_name = "COLUMN")]
     pub weights: Option<String>,
-    /// Bootstrap replicates, resampling subjects, for percentile 95 % intervals (0 = none).
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    pub bootstrap: usize,
+    /// Bootstrap replicates, resampling subjects, for percentile 95 % intervals and bootstrap
+    /// standard deviations (0 = none). Default: 0, or 2000 when refitting the bundled data/ (no
+    /// --data), so that the committed fits carry the subject bootstrap beside the analytic
+    /// intervals.
+    #[arg(long, value_name = "N")]
+    pub bootstrap: Option<usize>,
     /// Seed of the bootstrap.
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
+    /// Standard errors, t-tests and intervals: `cluster` (CR1 by subject, as statsmodels
+    /// cov_type='cluster', t with G − 1 df; the default with two or more subjects), `cr2`
+    /// (Bell–McCaffrey CR2 by subject with Satterthwaite df; recommended below 20 subjects,
+    /// where CR1 over-rejects), or `iid` (rows independent; the default with one subject).
+    #[arg(long, value_enum, value_name = "METHOD")]
+    pub se: Option<SeArg>,
     /// Do not write reports/ (plots and summary).
     #[arg(long)]
     pub no_report: bool,
+}
+
+/// `--se` values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SeArg {
+    /// Rows independent, one variance (per output).
+    Iid,
+    /// Clustered by subject, CR1 (statsmodels cov_type='cluster'), t with G − 1 df.
+    Cluster,
+    /// Clustered by subject, CR2 (Bell–McCaffrey) with Satterthwaite df.
+    Cr2,
+}
+
+impl From<SeArg> for SeMethod {
+    fn from(a: SeArg) -> SeMethod {
+        match a {
+            SeArg::Iid => SeMethod::Iid,
+            SeArg::Cluster => SeMethod::Cluster,
+            SeArg::Cr2 => SeMethod::Cr2,
+        }
+    }
 }
 
 fn default_data() -> anyhow::Result<Vec<PathBuf>> {
@@ -123,8 +167,13 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     let opts = FitOptions {
         robust: args.robust,
         weights: args.weights.clone(),
-        bootstrap: args.bootstrap,
+        bootstrap: args.bootstrap.unwrap_or(if args.data.is_empty() {
+            BUNDLED_BOOTSTRAP
+        } else {
+            0
+        }),
         seed: args.seed,
+        se: args.se.map(SeMethod::from),
     };
     let bar = if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(relations.len() as u64);
@@ -163,6 +212,20 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             r.rmse,
             unit,
             args.fits.join(format!("{}.json", r.relation)).display()
+        );
+    }
+    let few: Vec<String> = run
+        .outcomes
+        .iter()
+        .filter_map(|o| o.record.inference.as_ref().map(|i| (&o.record.relation, i)))
+        .filter(|(_, i)| i.method == "CR1" && i.clusters < CR2_RECOMMENDED_BELOW)
+        .map(|(r, i)| format!("{r} ({})", i.clusters))
+        .collect();
+    if !few.is_empty() {
+        println!(
+            "note: fewer than {CR2_RECOMMENDED_BELOW} subjects in {}: CR1 over-rejects with few \
+             clusters; --se cr2 is recommended",
+            few.join(", ")
         );
     }
     for (id, why) in &run.skipped {

@@ -53,10 +53,17 @@ pub struct CoefficientRecord {
     /// Written as the table `{ lo, hi }` (see the module docs), an open end as an absent key.
     #[serde(with = "bounds")]
     pub ci95: [Option<f64>; 2],
-    /// The published value (0 for per-subject levels).
-    pub published: f64,
+    /// The published value; `null` where the paper gives none (then there is no t-test).
+    pub published: Option<f64>,
     /// t-test of `value` against `published`.
     pub t_test: Option<TTestRecord>,
+    /// The standard error conditional on the breakpoint estimates, when `std_error` is the one
+    /// with the breakpoints free (Gauss–Newton over all parameters).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std_error_conditional: Option<f64>,
+    /// How this coefficient's standard error and interval were computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inference: Option<String>,
     /// Percentile 95 % interval `[lo, hi]` from the seeded bootstrap by subject
     /// (`--bootstrap N`); written as the table `{ lo, hi }` like `ci95`.
     #[serde(
@@ -65,6 +72,9 @@ pub struct CoefficientRecord {
         with = "closed_bounds"
     )]
     pub ci95_bootstrap: Option<[f64; 2]>,
+    /// Standard deviation of the bootstrap replicates (`--bootstrap N`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub se_bootstrap: Option<f64>,
     /// Why the coefficient was held at its published value instead of fitted.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub held: Option<String>,
@@ -149,6 +159,90 @@ pub struct DerivedRecord {
     pub published: f64,
 }
 
+/// How a fit's standard errors, t-tests and intervals were computed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct InferenceRecord {
+    /// `iid`, `CR1` or `CR2`.
+    pub method: String,
+    /// What the method is, in one sentence.
+    pub description: String,
+    /// Subjects (clusters).
+    pub clusters: usize,
+    /// Degrees of freedom of the t-tests (`null` when they differ by coefficient: CR2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub df: Option<f64>,
+    /// How breakpoints enter the linear coefficients' standard errors.
+    pub breakpoints: String,
+    /// Which method gaitfit recommends for these data, and why.
+    pub recommendation: String,
+}
+
+/// The confidence set of a breakpoint from its profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BreakpointRecord {
+    /// Breakpoint name.
+    pub name: String,
+    /// How the set was found.
+    pub method: String,
+    /// Admissible values examined: partitions of the rows (a breakpoint the model depends on
+    /// only through which rows lie on each side) or grid values.
+    pub admissible: usize,
+    /// Of those, accepted at 95 %.
+    pub accepted: usize,
+    /// The set's disjoint pieces `{ lo, hi }` (an absent end: the piece reaches the end of the
+    /// admissible range).
+    #[serde(with = "piece_list")]
+    pub pieces: Vec<[Option<f64>; 2]>,
+    /// Local minima of the profile over the admissible range.
+    pub local_minima: usize,
+    /// Whether the profile is regular (one piece inside the range, one local minimum in it,
+    /// a continuous model): only then has the breakpoint a standard error and a t-test.
+    pub regular: bool,
+    /// Why not, when not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub irregular_because: Option<String>,
+}
+
+/// Serde for a list of `[lo, hi]` pieces as `{ lo, hi }` tables (like `ci95`).
+mod piece_list {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    #[derive(Serialize, Deserialize)]
+    struct Piece {
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        lo: Option<f64>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        hi: Option<f64>,
+    }
+
+    pub fn serialize<S: Serializer>(v: &[[Option<f64>; 2]], s: S) -> Result<S::Ok, S::Error> {
+        v.iter()
+            .map(|p| Piece { lo: p[0], hi: p[1] })
+            .collect::<Vec<_>>()
+            .serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<[Option<f64>; 2]>, D::Error> {
+        Ok(Vec::<Piece>::deserialize(d)?
+            .into_iter()
+            .map(|p| [p.lo, p.hi])
+            .collect())
+    }
+}
+
+/// The bounded least-squares solves of a fit (relations with bounded coefficients).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BoundedRecord {
+    /// The solver.
+    pub solver: String,
+    /// Bounded solves made (the fit, leave-one-subject-out folds, bootstrap replicates).
+    pub solves: usize,
+    /// Of those, the ones whose KKT conditions were verified at the solution.
+    pub converged: usize,
+    /// Most active-set iterations any solve took.
+    pub max_iterations: usize,
+}
+
 /// The Huber robust refit (`--robust`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RobustRecord {
@@ -162,6 +256,9 @@ pub struct RobustRecord {
     pub converged: bool,
     /// Rows down-weighted (robust weight < 1).
     pub rows_downweighted: usize,
+    /// How the robust standard errors were computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cov: Option<String>,
     /// Coefficients (breakpoints held at the least-squares estimate).
     pub coefficients: Vec<CoefficientRecord>,
 }
@@ -200,6 +297,10 @@ pub struct FitRecord {
     pub coefficients: Vec<CoefficientRecord>,
     /// Coefficient of determination (see `r2_definition`).
     pub r2: f64,
+    /// The centred r², 1 − RSS/Σw(y − ȳ)², also for fits through the origin (what
+    /// `gaitfit check` gates on).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub r2_centred: Option<f64>,
     /// How r² is defined here (centred, or uncentred for fits through the origin).
     pub r2_definition: String,
     /// Adjusted r².
@@ -222,6 +323,18 @@ pub struct FitRecord {
     pub published_fit: PublishedFit,
     /// The input range the rows covered.
     pub valid_range: Vec<RangeRecord>,
+    /// What predictions do outside `valid_range`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outside_range: Option<String>,
+    /// How standard errors, t-tests and intervals were computed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inference: Option<InferenceRecord>,
+    /// Breakpoints' confidence sets.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub breakpoints: Vec<BreakpointRecord>,
+    /// Bounded least-squares solves and their convergence.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounded: Option<BoundedRecord>,
     /// Where the rows came from.
     pub data: DataRecord,
     /// gaitfit's version.
@@ -493,7 +606,7 @@ fn export_csv(records: &[FitRecord]) -> Result<String, ExportError> {
                 c.std_error.map(|v| format!("{v:?}")).unwrap_or_default(),
                 c.ci95[0].map(|v| format!("{v:?}")).unwrap_or_default(),
                 c.ci95[1].map(|v| format!("{v:?}")).unwrap_or_default(),
-                format!("{:?}", c.published),
+                c.published.map(|v| format!("{v:?}")).unwrap_or_default(),
                 c.held.is_some().to_string(),
                 r.n.to_string(),
                 format!("{:?}", r.r2),
@@ -626,7 +739,10 @@ pub fn rust_source(records: &[FitRecord]) -> Result<String, ExportError> {
                     "    /// - Bootstrap 95 % interval: `[{lo:?}, {hi:?}]`\n"
                 ));
             }
-            doc.push_str(&format!("    /// - Published: {:?}\n", c.published));
+            doc.push_str(&match c.published {
+                Some(v) => format!("    /// - Published: {v:?}\n"),
+                None => "    /// - Published: none (the paper gives no value)\n".to_string(),
+            });
             doc.push_str(&format!("    /// - Fit: {}\n", doc_text(&fit_line)));
             doc.push_str(&format!("    /// - Data: {data_line}\n"));
             if let Some(h) = &c.held {

@@ -7,12 +7,17 @@
 //! - [`nonlinear`]: nonlinear least squares through argmin's trust-region solver
 //!   ([`nonlinear::nls`]) for any [`nonlinear::Model`], and a bounded 1-D minimiser
 //!   ([`nonlinear::minimize_1d`]) for profiling breakpoints;
+//! - [`design`]: the linear part at fixed breakpoints from per-subject sufficient statistics
+//!   (per-subject effects absorbed), the normal-equation solve, covariances;
+//! - [`inference`]: iid, cluster-robust CR1 and CR2 (Bell–McCaffrey) standard errors;
 //! - [`stats`]: quantiles, LRE, r², AIC/BIC, leave-one-group-out and the seeded group bootstrap;
 //! - [`prec`]: every named tolerance of the fitting layer in one place;
 //! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
 use thiserror::Error;
 
 pub mod constrained;
+pub mod design;
+pub mod inference;
 pub mod nonlinear;
 pub mod ols;
 pub mod pipeline;

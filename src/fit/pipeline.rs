@@ -9,49 +9,61 @@
 //!    flagged as inconsistent, or without a usable weight are **rejected and reported** by reason;
 //! 2. [`Relation::plan`] says which coefficients the data can identify; the others are held at
 //!    their published values (and the record says why);
-//! 3. each free breakpoint is **profiled**: the linear coefficients are refitted (normal
-//!    equations in the relation's well-conditioned basis) at each trial value and the residual
-//!    sum of squares minimised with argmin's Brent method after a grid scan
-//!    ([`minimize_1d`]); two breakpoints are profiled by coordinate descent. A breakpoint that
-//!    marks a feature which may be absent (a plateau onset, see [`Relation::breakpoint_null`])
-//!    is kept only when an F-test against the model without the feature rejects at 5 %;
-//!    otherwise it is held at the published value with the test in the notes;
-//! 4. at the breakpoints' estimates the linear coefficients are solved by QR ([`ols`]) in the
-//!    relation's basis and mapped to the raw coefficients ([`Relation::basis_to_params`]); with a
-//!    per-subject effect (the running paper's `level`), each subject gets its own slope, the
-//!    global slope is their unweighted mean and `level[s]` the deviations (they sum to zero);
-//! 5. statistics: r² (centred, or uncentred without intercept), adjusted r², rmse = √(RSS/n),
-//!    residual mean square RSS/(n − p) with p counting breakpoints, AIC/BIC (Gaussian
-//!    likelihood), PRESS (leave-one-out) rmse from the leverages with breakpoints held at their
-//!    estimate, leave-one-subject-out rmse (everything refitted without the subject, which is
-//!    predicted with level 0), the published coefficients' r² and rmse on the same rows, t-tests
-//!    against the published values, profile-likelihood (F-based) intervals for breakpoints,
-//!    optional Huber IRLS and weighted fits and a seeded bootstrap by subject.
-//!
-//! Standard errors of linear coefficients are conditional on the breakpoint estimates (the
-//! usual profile approach); the bootstrap intervals, which refit the breakpoints in every
-//! replicate, include that uncertainty.
-//!
-//! [`minimize_1d`]: super::nonlinear::minimize_1d
-use super::ols::{huber_irls, ols, LinearFit, LinearProblem};
+//! 3. each free breakpoint is **profiled**: the linear coefficients are refitted at each trial
+//!    value and the residual sum of squares minimised (module `profile`: exactly over the
+//!    partitions of the rows for a breakpoint the model depends on only through which rows lie
+//!    on each side, by a grid scan and argmin's Brent method otherwise); two breakpoints are
+//!    profiled by coordinate descent. A breakpoint that marks a feature which may be absent (a
+//!    plateau onset, see [`Relation::breakpoint_null`]) is kept only when an F-test against the
+//!    model without the feature rejects at 5 %; otherwise it is held at the published value;
+//! 4. at the breakpoints' estimates the linear coefficients come from per-subject sufficient
+//!    statistics ([`super::design`]); a per-subject effect (the running paper's `level`, an
+//!    offset on the slope) is absorbed subject by subject (Frisch–Waugh–Lovell): the global
+//!    slope is the subjects' mean slope and `level[s]` the deviations (they sum to zero);
+//! 5. **inference** ([`super::inference`]): gait rows are repeated measures, so with two or more
+//!    subjects standard errors are clustered by subject (CR1, as statsmodels
+//!    `cov_type='cluster'`, t with G − 1 degrees of freedom) unless `--se iid` or `--se cr2`
+//!    (Bell–McCaffrey with Satterthwaite degrees of freedom) is asked for. The global slope under
+//!    a per-subject effect is a mean of G subject slopes; its clustered standard error follows
+//!    each subject's influence on that mean (its slope's deviation from the mean, and its pull on
+//!    the shared coefficients), so it estimates the spread a new sample of subjects would show;
+//! 6. **breakpoints**: the 95 % confidence set is the set of breakpoint values whose profile RSS
+//!    passes the F-test against the minimum, over every admissible partition of the rows (or a
+//!    grid over the whole search range for a continuous breakpoint), recorded as its pieces
+//!    and their hull (`ci95`). Only a regular profile — continuous model, one piece inside the
+//!    range, one local minimum in it — gives a breakpoint a standard error and a t-test; then
+//!    the linear coefficients' standard errors are those with the breakpoints free (Gauss–Newton
+//!    over all parameters), and the conditional ones are recorded beside them;
+//! 7. statistics: r² (centred, or uncentred without intercept — the centred one is always
+//!    recorded too), adjusted r², rmse = √(RSS/n), residual mean square RSS/(n − p) with p
+//!    counting breakpoints and per-subject slopes, AIC/BIC (Gaussian likelihood), PRESS
+//!    (leave-one-out) rmse from the leverages with breakpoints held at their estimate,
+//!    leave-one-subject-out rmse (everything refitted without the subject, which is predicted
+//!    with level 0), the published coefficients' r² and rmse on the same rows, t-tests against
+//!    the published values (where the paper gives one), optional Huber IRLS and weighted fits and
+//!    a seeded bootstrap by subject.
+use super::design::{augment, Covariance, DesignFit, Layout, SubjectSums, Totals, MAX_BASIS};
+use super::inference::{SeMethod, CR2_RECOMMENDED_BELOW};
+use super::ols::{huber_irls, LinearProblem};
+use super::prec::ILL_CONDITIONED;
 use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
 };
 use super::FitError;
 use crate::export::coeffs::{
     BootstrapRecord, CoefficientRecord, DataFile, DataRecord, DerivedRecord, FitRecord,
-    PublishedFit, RangeRecord, RejectionRecord, RobustRecord, TTestRecord,
+    InferenceRecord, PublishedFit, RangeRecord, RejectionRecord, RobustRecord, TTestRecord,
 };
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Observation, ParamKind, Relation};
 use profile::{
-    profile, profile_interval, refit, whole_subjects, Members, Profiler, SortedRows, Source, Subset,
+    confidence_set, profile, refit, whole_subjects, Members, Profiler, SortedRows, Source, Subset,
 };
 
 mod profile;
 use crate::units::parse_header;
 use nalgebra::{DMatrix, DVector};
-pub use profile::DISCRETE_MAX_EVALS;
+pub use profile::{DISCRETE_MAX_EVALS, PROFILE_GRID};
 use std::collections::BTreeMap;
 
 /// Huber tuning constant (95 % efficiency under normal errors).
@@ -76,9 +88,31 @@ pub struct FitOptions {
     pub bootstrap: usize,
     /// Seed of the bootstrap.
     pub seed: u64,
+    /// Standard errors: `None` = clustered by subject (CR1) with two or more subjects, else iid.
+    pub se: Option<SeMethod>,
 }
 
 impl FitOptions {
+    /// The standard-error method for rows from `n_subj` subjects: the one asked for, else CR1
+    /// with two or more subjects and iid with one. Clustered methods need two subjects.
+    pub fn se_method(&self, relation: &str, n_subj: usize) -> Result<SeMethod, FitError> {
+        match self.se {
+            None if n_subj >= 2 => Ok(SeMethod::Cluster),
+            None => Ok(SeMethod::Iid),
+            Some(SeMethod::Iid) => Ok(SeMethod::Iid),
+            Some(m) if n_subj >= 2 => Ok(m),
+            Some(m) => Err(FitError::TooFew {
+                relation: format!(
+                    "{relation} (--se {} clusters by subject; use --se iid for one subject)",
+                    m.label()
+                ),
+                what: "subjects".into(),
+                have: n_subj,
+                need: 2,
+            }),
+        }
+    }
+
     /// Checks the settings against the tables (the weights column must exist).
     pub fn validate(&self, tables: &[TrialsTable]) -> Result<(), FitError> {
         if let Some(w) = &self.weights {
@@ -257,192 +291,50 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
     p
 }
 
-/// How the design is laid out for a given set of free coefficients and subjects.
-#[derive(Debug, Clone)]
-struct Layout {
-    free: Vec<bool>,
-    nb: usize,
-    subj_col: Option<usize>,
-    n_subj: usize,
-}
-
-impl Layout {
-    fn new(rel: &dyn Relation, free: Vec<bool>, n_subj: usize) -> Layout {
-        let nb = rel.basis_len(&free);
-        let subj_col = if n_subj >= 2 && rel.subject_effect().is_some() {
-            rel.subject_column(&free)
-        } else {
-            None
-        };
-        Layout {
-            free,
-            nb,
-            subj_col,
-            n_subj,
-        }
-    }
-    fn ncols(&self) -> usize {
-        match self.subj_col {
-            Some(_) => self.nb - 1 + self.n_subj,
-            None => self.nb,
-        }
-    }
-    /// Fills the design row (sparse: `idx`/`val`, returns the count) and returns the offset.
-    #[inline]
-    fn row(
-        &self,
-        rel: &dyn Relation,
-        p: &[f64],
-        o: &Observation,
-        subject: usize,
-        idx: &mut [usize; 17],
-        val: &mut [f64; 17],
-    ) -> (usize, f64) {
-        let mut phi = [0.0; 16];
-        let off = rel.basis(p, &self.free, &o.x, &mut phi[..self.nb]);
-        let mut k = 0;
-        for (j, &v) in phi[..self.nb].iter().enumerate() {
-            if v == 0.0 {
-                continue;
-            }
-            let col = match self.subj_col {
-                Some(sc) if j == sc => self.nb - 1 + subject,
-                Some(sc) if j > sc => j - 1,
-                _ => j,
-            };
-            idx[k] = col;
-            val[k] = v;
-            k += 1;
-        }
-        (k, off)
-    }
-    /// The dense design row for the average subject (subject columns share the slope equally).
-    fn mean_row(&self, rel: &dyn Relation, p: &[f64], x: &[f64]) -> (DVector<f64>, f64) {
-        let mut phi = [0.0; 16];
-        let off = rel.basis(p, &self.free, x, &mut phi[..self.nb]);
-        let mut r = DVector::zeros(self.ncols());
-        for (j, &v) in phi[..self.nb].iter().enumerate() {
-            match self.subj_col {
-                Some(sc) if j == sc => {
-                    for s in 0..self.n_subj {
-                        r[self.nb - 1 + s] = v / self.n_subj as f64;
-                    }
-                }
-                Some(sc) if j > sc => r[j - 1] = v,
-                _ => r[j] = v,
-            }
-        }
-        (r, off)
-    }
-    /// The linear map from design coefficients to `[raw linear params; levels]`.
-    fn output_map(&self, rel: &dyn Relation, p: &[f64]) -> (DMatrix<f64>, DVector<f64>) {
-        let lm = rel.basis_to_params(p, &self.free);
-        let nc = self.ncols();
-        // A: design coefficients → relation-basis coefficients.
-        let mut a = DMatrix::zeros(self.nb, nc);
-        for j in 0..self.nb {
-            match self.subj_col {
-                Some(sc) if j == sc => {
-                    for s in 0..self.n_subj {
-                        a[(j, self.nb - 1 + s)] = 1.0 / self.n_subj as f64;
-                    }
-                }
-                Some(sc) if j > sc => a[(j, j - 1)] = 1.0,
-                _ => a[(j, j)] = 1.0,
-            }
-        }
-        let n_lin = lm.map.nrows();
-        let n_lev = if self.subj_col.is_some() {
-            self.n_subj
-        } else {
-            0
-        };
-        let mut g = DMatrix::zeros(n_lin + n_lev, nc);
-        let mut shift = DVector::zeros(n_lin + n_lev);
-        g.rows_mut(0, n_lin).copy_from(&(&lm.map * &a));
-        shift.rows_mut(0, n_lin).copy_from(&lm.shift);
-        if let Some(sc) = self.subj_col {
-            // level_s = β_s − mean(β); the relation-basis coefficient of column `sc` must equal
-            // the `on` parameter (documented requirement of `subject_column`).
-            for s in 0..self.n_subj {
-                for t in 0..self.n_subj {
-                    g[(n_lin + s, self.nb - 1 + t)] =
-                        if s == t { 1.0 } else { 0.0 } - 1.0 / self.n_subj as f64;
-                }
-            }
-            let _ = sc;
-        }
-        (g, shift)
-    }
-}
-
-/// Leave-one-subject-out for a fit with only linear coefficients to refit and no per-subject
-/// columns: every subject's weighted normal equations from one pass, each fold solved from the
-/// sums of the others (prefix + suffix over subjects, so no subtraction and no pass per fold).
-/// Per subject, in subject order: the squared prediction errors of its rows (level 0), or
-/// `None` when the fold is singular — what [`leave_one_group_out`] with a refit per fold gives.
+/// Leave-one-subject-out for a fit with only linear coefficients to refit: every subject's
+/// sums ([`SubjectSums`]) from one pass, each fold solved from the sums of the others (prefix +
+/// suffix over subjects: no subtraction, no pass per fold). Per subject, in subject order: the
+/// squared prediction errors of its rows (level 0), or `None` when the fold is singular.
 fn loso_from_subject_sums(
     rel: &dyn Relation,
     lay: &Layout,
     p: &[f64],
     prep: &Prepared,
-    n_subj: usize,
 ) -> Vec<Option<Vec<f64>>> {
-    let nc = lay.ncols();
-    let m = nc * nc + nc + 1;
-    // Per subject: XᵀWX (lower triangle by first index, as in `solve_ne`), XᵀWy, yᵀWy.
-    let mut sums = vec![0.0f64; n_subj * m];
-    let mut idx = [0usize; 17];
-    let mut val = [0.0f64; 17];
-    for (i, o) in prep.obs.iter().enumerate() {
-        let s = prep.subject[i];
-        let (k, off) = lay.row(rel, p, o, s, &mut idx, &mut val);
-        let w = prep.weights[i];
-        let y = o.y - off;
-        let acc = &mut sums[s * m..(s + 1) * m];
-        acc[m - 1] += w * y * y;
-        for a in 0..k {
-            let wa = w * val[a];
-            let ia = idx[a];
-            acc[nc * nc + ia] += wa * y;
-            for b in 0..=a {
-                acc[ia * nc + idx[b]] += wa * val[b];
-            }
-        }
+    let n_subj = prep.subjects.len();
+    let m = lay.m();
+    let nes = super::design::subject_normal_equations(rel, lay, p, prep, None, None, n_subj);
+    let Some(sums) = nes
+        .iter()
+        .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
+        .collect::<Option<Vec<_>>>()
+    else {
+        return vec![None; n_subj];
+    };
+    drop(nes);
+    let mut prefix = Vec::with_capacity(n_subj + 1);
+    prefix.push(Totals::zeros(m));
+    for s in &sums {
+        let mut t = prefix[prefix.len() - 1].clone();
+        t.add(s, 1.0);
+        prefix.push(t);
     }
-    let add = |into: &mut [f64], from: &[f64]| into.iter_mut().zip(from).for_each(|(a, b)| *a += b);
-    let mut prefix = vec![0.0f64; (n_subj + 1) * m];
-    for s in 0..n_subj {
-        let (head, tail) = prefix.split_at_mut((s + 1) * m);
-        tail[..m].copy_from_slice(&head[s * m..]);
-        add(&mut tail[..m], &sums[s * m..(s + 1) * m]);
-    }
-    let mut suffix = vec![0.0f64; (n_subj + 1) * m];
+    let mut suffix = vec![Totals::zeros(m); n_subj + 1];
     for s in (0..n_subj).rev() {
-        let (head, tail) = suffix.split_at_mut((s + 1) * m);
-        head[s * m..].copy_from_slice(&tail[..m]);
-        add(&mut head[s * m..], &sums[s * m..(s + 1) * m]);
+        let mut t = suffix[s + 1].clone();
+        t.add(&sums[s], 1.0);
+        suffix[s] = t;
     }
     let mut rows_of = vec![Vec::new(); n_subj];
     for (i, &s) in prep.subject.iter().enumerate() {
         rows_of[s].push(i);
     }
-    let (g, shift) = lay.output_map(rel, p);
     (0..n_subj)
         .map(|s| {
-            let mut acc = prefix[s * m..(s + 1) * m].to_vec();
-            add(&mut acc, &suffix[(s + 1) * m..(s + 2) * m]);
-            let xtx = symmetric_xtx(nc, &acc);
-            let (beta, _) = solve_normal(nc, &xtx, &acc[nc * nc..nc * nc + nc], acc[m - 1])?;
-            let out = &g * &beta + &shift;
-            let mut q = p.to_vec();
-            let mut j = 0;
-            for (i, spec) in rel.parameters().iter().enumerate() {
-                if spec.kind == ParamKind::Linear {
-                    q[i] = out[j];
-                    j += 1;
-                }
-            }
+            let mut t = prefix[s].clone();
+            t.add_totals(&suffix[s + 1]);
+            let (coef, _) = t.solve(lay)?;
+            let q = lay.params(rel, p, &coef);
             Some(
                 rows_of[s]
                     .iter()
@@ -454,75 +346,6 @@ fn loso_from_subject_sums(
             )
         })
         .collect()
-}
-
-/// Normal-equation solve on a subset of rows: (coefficients, weighted RSS). Used for profiling,
-/// cross-validation and the bootstrap; the reported fit uses QR.
-fn solve_ne(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p: &[f64],
-    prep: &Prepared,
-    rows: Option<&[usize]>,
-    subj_map: Option<&[usize]>,
-) -> Option<(DVector<f64>, f64)> {
-    let nc = lay.ncols();
-    // Accumulate into flat buffers (row-major, lower triangle by first index): this loop is the
-    // cost of every profile evaluation.
-    let mut acc = vec![0.0f64; nc * nc];
-    let mut aty = vec![0.0f64; nc];
-    let mut yty = 0.0;
-    let mut idx = [0usize; 17];
-    let mut val = [0.0f64; 17];
-    let mut add = |i: usize| {
-        let o = &prep.obs[i];
-        let s = subj_map.map_or(prep.subject[i], |m| m[prep.subject[i]]);
-        let (k, off) = lay.row(rel, p, o, s, &mut idx, &mut val);
-        let w = prep.weights[i];
-        let y = o.y - off;
-        yty += w * y * y;
-        for a in 0..k {
-            let wa = w * val[a];
-            let ia = idx[a];
-            aty[ia] += wa * y;
-            let rowa = &mut acc[ia * nc..ia * nc + nc];
-            for b in 0..=a {
-                rowa[idx[b]] += wa * val[b];
-            }
-        }
-    };
-    match rows {
-        Some(r) => r.iter().for_each(|&i| add(i)),
-        None => (0..prep.obs.len()).for_each(&mut add),
-    }
-    let xtx = symmetric_xtx(nc, &acc);
-    solve_normal(nc, &xtx, &aty, yty)
-}
-
-/// Solves normal equations (`xtx` full `nc × nc` row-major): (coefficients, weighted RSS), or
-/// `None` when the design is singular. Columns are equilibrated before Cholesky so that badly
-/// scaled ones do not fail it.
-fn solve_normal(nc: usize, xtx: &[f64], xty: &[f64], yty: f64) -> Option<(DVector<f64>, f64)> {
-    let d: Vec<f64> = (0..nc)
-        .map(|j| {
-            let v = xtx[j * nc + j];
-            if v > 0.0 {
-                1.0 / v.sqrt()
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    if d.contains(&0.0) || d.iter().any(|v| !v.is_finite()) {
-        return None;
-    }
-    let s = DMatrix::from_fn(nc, nc, |a, b| xtx[a * nc + b] * (d[a] * d[b]));
-    let rhs = DVector::from_iterator(nc, (0..nc).map(|j| xty[j] * d[j]));
-    let chol = s.cholesky()?;
-    let z = chol.solve(&rhs);
-    let beta = DVector::from_iterator(nc, (0..nc).map(|j| z[j] * d[j]));
-    let rss = (yty - beta.dot(&DVector::from_column_slice(xty))).max(0.0);
-    Some((beta, rss))
 }
 
 /// Everything a fit produced: the record plus what plots need.
@@ -542,27 +365,113 @@ pub struct FitOutcome {
     pub residuals: Vec<f64>,
     /// Refit coefficients (global, `parameters()` order).
     pub values: Vec<f64>,
+    band: Band,
+}
+
+/// What the confidence band of the mean prediction needs.
+#[derive(Debug, Clone)]
+struct Band {
     lay: Layout,
-    beta: DVector<f64>,
-    cov: DMatrix<f64>,
-    df: f64,
+    coef: DVector<f64>,
+    cov: Covariance,
+    /// Free breakpoints in θ (parameter index), when the covariance has them free.
+    bps: Vec<usize>,
+}
+
+impl Band {
+    /// The mean prediction at `x` for parameters `p` and basis coefficients `coef`.
+    fn mean(&self, rel: &dyn Relation, p: &[f64], coef: &DVector<f64>, x: &[f64]) -> f64 {
+        let mut phi = [0.0; MAX_BASIS];
+        let off = rel.basis(p, &self.lay.free, x, &mut phi[..self.lay.nb]);
+        off + (0..self.lay.nb).map(|j| phi[j] * coef[j]).sum::<f64>()
+    }
+    /// The gradient of the mean prediction over θ.
+    fn ell(&self, rel: &dyn Relation, p: &[f64], x: &[f64]) -> DVector<f64> {
+        let lay = &self.lay;
+        let mut phi = [0.0; MAX_BASIS];
+        rel.basis(p, &lay.free, x, &mut phi[..lay.nb]);
+        let k = self.cov.k;
+        let dim = k + usize::from(self.cov.has_fe);
+        let mut ell = DVector::zeros(dim);
+        let mut g = 0;
+        for (j, &v) in phi[..lay.nb].iter().enumerate() {
+            if Some(j) == lay.subj_col {
+                ell[k] = v;
+            } else {
+                ell[g] = v;
+                g += 1;
+            }
+        }
+        for (b, &i) in self.bps.iter().enumerate() {
+            let h = step(p[i]);
+            let (mut up, mut dn) = (p.to_vec(), p.to_vec());
+            up[i] += h;
+            dn[i] -= h;
+            ell[g + b] = (self.mean(rel, &up, &self.coef, x) - self.mean(rel, &dn, &self.coef, x))
+                / (2.0 * h);
+        }
+        ell
+    }
+}
+
+/// Step of the central differences with respect to a breakpoint at `t`.
+fn step(t: f64) -> f64 {
+    1e-6 * t.abs().max(1.0)
 }
 
 impl FitOutcome {
     /// The refit prediction for an average subject at `x` with its 95 % confidence band
-    /// (conditional on the breakpoint estimates): `(mean, lo, hi)`.
+    /// (under the fit's inference method): `(mean, lo, hi)`.
     pub fn band(&self, x: &[f64]) -> (f64, f64, f64) {
         let rel = self.refit.as_ref();
-        let (r, off) = self.lay.mean_row(rel, &self.values, x);
-        let m = off + r.dot(&self.beta);
-        let var = (r.transpose() * &self.cov * &r)[(0, 0)].max(0.0);
-        let q = t_quantile(0.5 + 0.5 * CONFIDENCE, self.df);
+        let b = &self.band;
+        let m = b.mean(rel, &self.values, &b.coef, x);
+        let ell = b.ell(rel, &self.values, x);
+        let var = ell.dot(&(&b.cov.v * &ell)).max(0.0);
+        let q = t_quantile(0.5 + 0.5 * CONFIDENCE, b.cov.df(&ell));
         (m, m - q * var.sqrt(), m + q * var.sqrt())
     }
 }
 
 fn opt(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
+}
+
+/// The inference record's text for a method on `g` subjects.
+fn inference_record(
+    method: SeMethod,
+    g: usize,
+    df_iid: f64,
+    breakpoints: String,
+) -> InferenceRecord {
+    let recommendation = if g < 2 {
+        "one subject: rows can only be treated as independent (iid); the standard errors \
+         ignore that they are repeated measures of one person"
+            .to_string()
+    } else if g < CR2_RECOMMENDED_BELOW {
+        format!(
+            "{g} subjects (< {CR2_RECOMMENDED_BELOW}): CR2 with Bell–McCaffrey degrees of freedom \
+             (--se cr2) is recommended; CR1 with G − 1 degrees of freedom over-rejects with few \
+             or unbalanced clusters"
+        )
+    } else {
+        format!(
+            "{g} subjects: CR1 (the default) is adequate; CR2 (--se cr2) is the cautious choice \
+             when cluster sizes are very unbalanced"
+        )
+    };
+    InferenceRecord {
+        method: method.label().to_string(),
+        description: method.describe().to_string(),
+        clusters: g,
+        df: match method {
+            SeMethod::Iid => Some(df_iid),
+            SeMethod::Cluster => Some(g as f64 - 1.0),
+            SeMethod::Cr2 => None,
+        },
+        breakpoints,
+        recommendation,
+    }
 }
 
 /// Fits `rel` (its current coefficients are the published reference and the values of held
@@ -578,17 +487,19 @@ pub fn fit_relation(
     let n = prep.obs.len();
     let specs = rel.parameters();
     let published = rel.values().to_vec();
+    let n_subj = prep.subjects.len();
+    let method = opts.se_method(&id, n_subj)?;
     // Rows sorted once by the breakpoint key, with prefix sums: every profile evaluation
-    // below (search, F-test, intervals, folds, bootstrap) then costs O(p³), not a pass.
+    // below (search, F-test, confidence sets, folds, bootstrap) then costs O(p³), not a pass.
     // The tree over all rows serves fits without per-subject columns; with them, every
     // evaluation (and fold, and replicate) sums subjects' trees.
-    let with_all = !(rel.subject_effect().is_some() && prep.subjects.len() >= 2);
+    let with_all = !(rel.subject_effect().is_some() && n_subj >= 2);
     let sorted = rel
         .sorted_profile()
         .map(|form| SortedRows::new(form, &prep, with_all));
-    let all_keys: Vec<f64> = sorted.as_ref().map_or_else(Vec::new, |sr| {
-        sr.distinct_keys(&vec![true; prep.subjects.len()])
-    });
+    let all_keys: Vec<f64> = sorted
+        .as_ref()
+        .map_or_else(Vec::new, |sr| sr.distinct_keys(&vec![true; n_subj]));
     let src = match &sorted {
         Some(sr) => Source::Sorted {
             sr,
@@ -599,6 +510,7 @@ pub fn fit_relation(
             prep: &prep,
             rows: None,
             subj_map: None,
+            n_subj,
         },
     };
     let plan = match &sorted {
@@ -607,15 +519,17 @@ pub fn fit_relation(
     };
     let mut free: Vec<bool> = plan.held.iter().map(|h| h.is_none()).collect();
     let mut held_reason: Vec<Option<String>> = plan.held.clone();
-    let n_subj = prep.subjects.len();
     let mut notes = Vec::new();
 
-    let n_params_max = Layout::new(rel, free.clone(), n_subj).ncols()
-        + free
-            .iter()
+    let n_fe = |lay: &Layout| if lay.subj_col.is_some() { n_subj } else { 0 };
+    let n_bp_free = |free: &[bool]| {
+        free.iter()
             .zip(specs)
             .filter(|(f, s)| **f && s.kind == ParamKind::Breakpoint)
-            .count();
+            .count()
+    };
+    let lay0 = Layout::new(rel, free.clone(), n_subj);
+    let n_params_max = lay0.m() + n_fe(&lay0) + n_bp_free(&free);
     if n < n_params_max + 2 {
         let mut why = String::new();
         if let Some(r) = prep.rejected.first() {
@@ -642,7 +556,7 @@ pub fn fit_relation(
 
     // Profile the breakpoints; drop optional ones the data do not support.
     let mut p = published.clone();
-    let mut lay = Layout::new(rel, free.clone(), n_subj);
+    let mut lay = lay0;
     p = profile(
         &Profiler {
             rel,
@@ -706,13 +620,11 @@ pub fn fit_relation(
         bound_flag[b.index] = Some("bound active".into());
     }
     lay = Layout::new(rel, free.clone(), n_subj);
-    let nc = lay.ncols();
-    let n_bp = free
-        .iter()
-        .zip(specs)
-        .filter(|(f, s)| **f && s.kind == ParamKind::Breakpoint)
-        .count();
-    let k = nc + n_bp;
+    let bps: Vec<usize> = (0..specs.len())
+        .filter(|&i| free[i] && specs[i].kind == ParamKind::Breakpoint)
+        .collect();
+    let n_bp = bps.len();
+    let k = lay.m() + n_fe(&lay) + n_bp;
     if n < k + 2 {
         return Err(FitError::TooFew {
             relation: id.clone(),
@@ -722,82 +634,32 @@ pub fn fit_relation(
         });
     }
 
-    // The reported fit: QR at the breakpoint estimates.
-    let mut x = DMatrix::<f64>::zeros(n, nc);
-    let mut y = DVector::<f64>::zeros(n);
-    let mut offsets = vec![0.0; n];
-    let mut idx = [0usize; 17];
-    let mut val = [0.0f64; 17];
-    for i in 0..n {
-        let (kk, off) = lay.row(rel, &p, &prep.obs[i], prep.subject[i], &mut idx, &mut val);
-        for a in 0..kk {
-            x[(i, idx[a])] = val[a];
-        }
-        offsets[i] = off;
-        y[i] = prep.obs[i].y - off;
-    }
-    let w = DVector::from_vec(prep.weights.clone());
-    let weighted = opts.weights.is_some();
-    let col_names: Vec<String> = (0..nc)
-        .map(|j| match lay.subj_col {
-            Some(_) if j >= lay.nb - 1 => format!(
-                "{}[{}]",
-                rel.subject_effect().map_or("", |e| e.on),
-                prep.subjects[j - (lay.nb - 1)]
-            ),
-            _ => format!("basis column {j}"),
-        })
-        .collect();
-    let mut problem = LinearProblem::new(&x, &y)
-        .named(&id)
-        .with_column_names(&col_names);
-    if weighted {
-        problem = problem.with_weights(&w);
-    }
-    let lf: LinearFit = ols(&problem)?;
-    if lf.ill_conditioned() {
+    // The reported fit at the breakpoint estimates.
+    let fit = DesignFit::new(rel, &lay, &p, &prep).ok_or_else(|| FitError::Singular {
+        relation: id.clone(),
+        message: "the normal equations at the breakpoint estimates are not positive definite \
+                  (too few distinct inputs for the free coefficients)"
+            .into(),
+    })?;
+    if fit.condition_number > ILL_CONDITIONED {
         notes.push(format!(
             "the design is ill-conditioned (condition number {:.2e}); coefficients may have lost digits",
-            lf.condition_number
+            fit.condition_number
         ));
     }
-    let (g, shift) = lay.output_map(rel, &p);
-    let out = &g * &lf.coef + &shift;
-    let cov_out = &g * &lf.cov * g.transpose();
-    let df = (n - k) as f64;
-    let rss = lf.rss;
-    let sigma2 = rss / df;
-    // ols counted only the linear columns; rescale its covariance to the full p.
-    let cov_scale = if lf.df_resid > 0 {
-        sigma2 / (lf.rss / lf.df_resid as f64)
-    } else {
-        1.0
-    };
-    let cov_out = cov_out * cov_scale;
-    let cov_beta = &lf.cov * cov_scale;
-    let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
-
-    let mut values = p.clone();
-    {
-        let mut j = 0;
-        for (i, s) in specs.iter().enumerate() {
-            if s.kind == ParamKind::Linear {
-                values[i] = out[j];
-                j += 1;
-            }
-        }
-    }
+    let weighted = opts.weights.is_some();
+    let values = lay.params(rel, &p, &fit.coef);
     notes.extend(super::constrained::violations(rel, &values, &free));
-    // Fitted values and residuals in the response's terms.
-    let fitted: Vec<f64> = (0..n).map(|i| offsets[i] + lf.fitted[i]).collect();
+    let df = (n - k) as f64;
+    let rss = fit.rss;
+    let sigma2 = rss / df;
+    let fitted = fit.fitted.clone();
+    let residuals = fit.residuals.clone();
     let obs_y: Vec<f64> = prep.obs.iter().map(|o| o.y).collect();
-    let residuals: Vec<f64> = (0..n).map(|i| obs_y[i] - fitted[i]).collect();
     let wopt = weighted.then_some(prep.weights.as_slice());
+    let r2c = r2_centred(&obs_y, rss, wopt);
     let (r2, r2_def) = if rel.has_intercept() {
-        (
-            r2_centred(&obs_y, rss, wopt),
-            "centred: 1 − RSS/Σ(y − ȳ)²".to_string(),
-        )
+        (r2c, "centred: 1 − RSS/Σ(y − ȳ)²".to_string())
     } else {
         (
             r2_uncentred(&obs_y, rss, wopt),
@@ -812,78 +674,257 @@ pub fn fit_relation(
     };
     let rmse = (residuals.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
     let press: f64 = (0..n)
-        .map(|i| (residuals[i] / (1.0 - lf.leverage[i])).powi(2))
+        .map(|i| (residuals[i] / (1.0 - fit.leverage[i])).powi(2))
         .sum::<f64>()
         / n as f64;
-    let sum_log_w = if weighted { lf.sum_log_w } else { 0.0 };
+    let sum_log_w = if weighted { fit.sum_log_w } else { 0.0 };
+
+    // Covariances: conditional on the breakpoints, and (regular profiles) with them free.
+    let fe_d: Vec<DVector<f64>> = fit.fe.iter().map(|(d, _)| d.clone()).collect();
+    let cov_c = Covariance::new(method, &fit.a, &fit.clusters, &fit, &fe_d, n, k, k - n_bp)
+        .ok_or_else(|| FitError::Singular {
+            relation: id.clone(),
+            message: "the covariance of the coefficients is singular".into(),
+        })?;
+    let tq_iid = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
+    let mut bp_records = Vec::new();
+    let mut bp_hull: BTreeMap<usize, [Option<f64>; 2]> = BTreeMap::new();
+    let mut all_regular = n_bp > 0;
+    for &i in &bps {
+        let pr = Profiler {
+            rel,
+            lay: &lay,
+            src,
+        };
+        let rmin = pr.rss(&p);
+        let thr = rmin * (1.0 + tq_iid * tq_iid / df);
+        let set = confidence_set(&pr, &p, i, &plan.search, thr);
+        let (rec, hull) = set.record(specs[i].name);
+        all_regular &= rec.regular;
+        bp_hull.insert(i, hull);
+        bp_records.push(rec);
+    }
+    let cov_f = if all_regular {
+        let coef = fit.coef.clone();
+        let sc = lay.subj_col;
+        let subj_coef = |s: usize| {
+            let mut c = coef.clone();
+            if let Some(sc) = sc {
+                c[sc] = fit.gammas[s];
+            }
+            c
+        };
+        let subj_coefs: Vec<DVector<f64>> = (0..n_subj).map(subj_coef).collect();
+        let mean_at = |q: &[f64], c: &DVector<f64>, x: &[f64]| {
+            let mut phi = [0.0; MAX_BASIS];
+            let off = rel.basis(q, &lay.free, x, &mut phi[..lay.nb]);
+            off + (0..lay.nb).map(|j| phi[j] * c[j]).sum::<f64>()
+        };
+        let jac = |row: usize, out: &mut [f64]| {
+            let o = &prep.obs[row];
+            let c = &subj_coefs[prep.subject[row]];
+            for (b, &i) in bps.iter().enumerate() {
+                let h = step(p[i]);
+                let (mut up, mut dn) = (p.clone(), p.clone());
+                up[i] += h;
+                dn[i] -= h;
+                out[b] = (mean_at(&up, c, &o.x) - mean_at(&dn, c, &o.x)) / (2.0 * h);
+            }
+        };
+        let aug = augment(rel, &fit, &p, &prep, n_bp, &jac);
+        Covariance::new(method, &aug.a, &aug.clusters, &fit, &aug.d, n, k, k)
+    } else {
+        None
+    };
+    if all_regular && cov_f.is_none() {
+        notes.push(
+            "the covariance with the breakpoints free is singular: standard errors are \
+             conditional on the breakpoint estimates"
+                .into(),
+        );
+    }
+
+    // Linear parameters as functions of θ: H (rows: linear params; columns: θ).
+    let lm = rel.basis_to_params(&p, &free);
+    let n_lin = lm.map.nrows();
+    let m = lay.m();
+    let theta_map = |cov: &Covariance, with_bps: bool| -> DMatrix<f64> {
+        let dim = cov.k + usize::from(cov.has_fe);
+        // θ → basis coefficients.
+        let mut e = DMatrix::zeros(lay.nb, dim);
+        let mut g = 0;
+        for j in 0..lay.nb {
+            if Some(j) == lay.subj_col {
+                e[(j, cov.k)] = 1.0;
+            } else {
+                e[(j, g)] = 1.0;
+                g += 1;
+            }
+        }
+        let mut h = &lm.map * e;
+        if with_bps {
+            for (b, &i) in bps.iter().enumerate() {
+                let st = step(p[i]);
+                let (mut up, mut dn) = (p.clone(), p.clone());
+                up[i] += st;
+                dn[i] -= st;
+                let lu = rel.basis_to_params(&up, &free);
+                let ld = rel.basis_to_params(&dn, &free);
+                let d = ((&lu.map * &fit.coef + &lu.shift) - (&ld.map * &fit.coef + &ld.shift))
+                    / (2.0 * st);
+                h.column_mut(m + b).copy_from(&d);
+            }
+        }
+        h
+    };
+    let h_c = theta_map(&cov_c, false);
+    let h_f = cov_f.as_ref().map(|c| theta_map(c, true));
+    let (cov, h_main) = match (&cov_f, &h_f) {
+        (Some(c), Some(h)) => (c, h),
+        _ => (&cov_c, &h_c),
+    };
+    let bp_text = if n_bp == 0 {
+        "no free breakpoints".to_string()
+    } else if cov_f.is_some() {
+        "free: linear standard errors are Gauss–Newton over all parameters, breakpoints \
+         included (std_error); those conditional on the breakpoint estimates are recorded as \
+         std_error_conditional"
+            .to_string()
+    } else {
+        "conditional on the breakpoint estimates: a breakpoint whose profile is irregular has \
+         no standard error, so the linear coefficients' are conditional on it (see breakpoints \
+         and the subject bootstrap for the uncertainty it adds)"
+            .to_string()
+    };
+    let inference = inference_record(method, n_subj, df, bp_text);
+    let how = |cov: &Covariance, free_bps: bool| {
+        format!(
+            "{}{}",
+            match cov.method {
+                SeMethod::Iid => format!("iid, t with {} df", cov.df_resid),
+                SeMethod::Cluster => format!(
+                    "CR1 by subject ({} clusters), t with {} df",
+                    cov.g,
+                    cov.g - 1
+                ),
+                SeMethod::Cr2 => format!(
+                    "CR2 by subject ({} clusters), t with Bell–McCaffrey df",
+                    cov.g
+                ),
+            },
+            match (n_bp, free_bps) {
+                (0, _) => "",
+                (_, true) => "; breakpoints free",
+                (_, false) => "; conditional on the breakpoint estimates",
+            }
+        )
+    };
 
     // Coefficients.
     let mut coefs = Vec::new();
     let mut lin_j = 0;
     for (i, s) in specs.iter().enumerate() {
-        let (value, se, ci) = if s.kind == ParamKind::Linear {
-            let j = lin_j;
-            lin_j += 1;
-            if free[i] {
-                let se = cov_out[(j, j)].max(0.0).sqrt();
-                let v = out[j];
-                (v, Some(se), [opt(v - tq * se), opt(v + tq * se)])
-            } else {
-                (p[i], None, [None, None])
-            }
-        } else if free[i] {
-            let (lo, hi) = profile_interval(
-                &Profiler {
-                    rel,
-                    lay: &lay,
-                    src,
-                },
-                &p,
-                i,
-                &plan.search,
-                df,
-                tq,
-            );
-            let se = match (lo, hi) {
-                (Some(a), Some(b)) => Some((b - a) / (2.0 * tq)),
-                _ => None,
-            };
-            (p[i], se, [lo, hi])
-        } else {
-            (published[i], None, [None, None])
-        };
-        let t_test = se.map(|se| {
-            let t = TTest::new(value, published[i], se, df);
-            TTestRecord {
-                t: opt(t.t),
-                df,
-                p_value: opt(t.p_value),
-            }
-        });
-        coefs.push(CoefficientRecord {
+        let cited = s.cited.then_some(published[i]);
+        let mut rec = CoefficientRecord {
             name: s.name.to_string(),
             unit: s.unit.to_string(),
-            value,
-            std_error: se,
-            ci95: ci,
-            published: published[i],
-            t_test,
+            value: values[i],
+            std_error: None,
+            ci95: [None, None],
+            published: cited,
+            t_test: None,
+            std_error_conditional: None,
+            inference: None,
             ci95_bootstrap: None,
+            se_bootstrap: None,
             held: if free[i] {
                 None
             } else {
                 held_reason[i].clone()
             },
             flag: bound_flag[i].clone(),
-        });
+        };
+        let mut se_df: Option<(f64, f64)> = None;
+        if s.kind == ParamKind::Linear {
+            let j = lin_j;
+            lin_j += 1;
+            if free[i] {
+                let ell = h_main.row(j).transpose();
+                let se = ell.dot(&(&cov.v * &ell)).max(0.0).sqrt();
+                se_df = Some((se, cov.df(&ell)));
+                if cov_f.is_some() {
+                    let lc = h_c.row(j).transpose();
+                    rec.std_error_conditional = Some(lc.dot(&(&cov_c.v * &lc)).max(0.0).sqrt());
+                }
+                rec.inference = Some(how(cov, cov_f.is_some()));
+            }
+        } else if free[i] {
+            let hull = bp_hull.get(&i).copied().unwrap_or([None, None]);
+            rec.ci95 = hull;
+            match (&cov_f, bps.iter().position(|&b| b == i)) {
+                (Some(c), Some(b)) => {
+                    let mut ell = DVector::zeros(c.k + usize::from(c.has_fe));
+                    ell[m + b] = 1.0;
+                    let se = c.v[(m + b, m + b)].max(0.0).sqrt();
+                    let d = c.df(&ell);
+                    rec.std_error = Some(se);
+                    if let Some(pv) = cited {
+                        let t = TTest::new(values[i], pv, se, d);
+                        rec.t_test = Some(TTestRecord {
+                            t: opt(t.t),
+                            df: d,
+                            p_value: opt(t.p_value),
+                        });
+                    }
+                    rec.inference = Some(format!(
+                        "95 % interval: F-based profile confidence set (see breakpoints); \
+                         standard error and t-test: {}",
+                        how(c, true)
+                    ));
+                }
+                _ => {
+                    rec.inference = Some(
+                        "95 % interval: hull of the F-based profile confidence set (see \
+                         breakpoints); irregular profile: no standard error, no t-test"
+                            .into(),
+                    );
+                }
+            }
+        }
+        if let Some((se, d)) = se_df {
+            let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, d);
+            rec.std_error = Some(se);
+            rec.ci95 = [opt(values[i] - tq * se), opt(values[i] + tq * se)];
+            if let Some(pv) = cited {
+                let t = TTest::new(values[i], pv, se, d);
+                rec.t_test = Some(TTestRecord {
+                    t: opt(t.t),
+                    df: d,
+                    p_value: opt(t.p_value),
+                });
+            }
+        }
+        coefs.push(rec);
     }
-    let n_lin = rel.n_linear();
+    let _ = n_lin;
     if let (Some(e), Some(_)) = (rel.subject_effect(), lay.subj_col) {
+        // A subject's own slope is informed by that subject's rows only: no cluster-robust
+        // standard error exists for it; its standard error is the iid one within the subject,
+        // conditional on the subjects fitted.
+        let gf = n_subj as f64;
+        let kappa = fe_d.iter().fold(DVector::zeros(m), |a, d| a + d) / gf;
+        let minv = super::inference::inverse_factor(&fit.a)
+            .map(|l| &l * l.transpose())
+            .unwrap_or_else(|| DMatrix::zeros(m, m));
+        let inv_szz_mean: f64 = fit.fe.iter().map(|(_, s)| 1.0 / s).sum::<f64>() / (gf * gf);
+        let tq = tq_iid;
         for (s, name) in prep.subjects.iter().enumerate() {
-            let j = n_lin + s;
-            let v = out[j];
-            let se = cov_out[(j, j)].max(0.0).sqrt();
-            let t = TTest::new(v, 0.0, se, df);
+            let v = fit.gammas[s] - fit.gamma_bar;
+            let (d, szz) = &fit.fe[s];
+            let dk = d - &kappa;
+            let var =
+                sigma2 * ((1.0 / szz) * (1.0 - 2.0 / gf) + inv_szz_mean + dk.dot(&(&minv * &dk)));
+            let se = var.max(0.0).sqrt();
             let flag = (v.abs() > e.paper_bound).then(|| {
                 format!(
                     "outside the paper's range ±{} {} for {}",
@@ -902,20 +943,25 @@ pub fn fit_relation(
                 value: v,
                 std_error: Some(se),
                 ci95: [opt(v - tq * se), opt(v + tq * se)],
-                published: 0.0,
-                t_test: Some(TTestRecord {
-                    t: opt(t.t),
-                    df,
-                    p_value: opt(t.p_value),
-                }),
+                published: None,
+                t_test: None,
+                std_error_conditional: None,
+                inference: Some(format!(
+                    "iid within the subject, conditional on the subjects fitted (t with {df} df): \
+                     one subject's rows alone inform its level, so no cluster-robust standard \
+                     error exists; the paper gives a range (±{}), not a value",
+                    e.paper_bound
+                )),
                 ci95_bootstrap: None,
+                se_bootstrap: None,
                 held: None,
                 flag,
             });
         }
         notes.push(format!(
-            "{} is fitted per subject as an offset on {} (the offsets sum to zero, so {} is the \
-             average subject's); held-out and new subjects are predicted with {} = 0",
+            "{} is fitted per subject as an offset on {} (absorbed subject by subject; the \
+             offsets sum to zero, so {} is the average subject's); held-out and new subjects are \
+             predicted with {} = 0",
             e.name, e.on, e.on, e.name
         ));
     } else if rel.subject_effect().is_some() {
@@ -926,6 +972,7 @@ pub fn fit_relation(
     }
 
     // Leave-one-subject-out.
+    let plan_fixed = rel.plan(&[]) == plan;
     let (loso_rmse, loso_note) = if n_subj >= 3 {
         let sq_err = |q: &[f64], i: usize| {
             let o = &prep.obs[i];
@@ -933,7 +980,7 @@ pub fn fit_relation(
         };
         let res: Vec<Vec<f64>> = match &sorted {
             // Folds are subject multisets: no pass over the training rows.
-            Some(sr) => {
+            Some(sr) if n_bp > 0 => {
                 let mut rows_of = vec![Vec::new(); n_subj];
                 for (i, &s) in prep.subject.iter().enumerate() {
                     rows_of[s].push(i);
@@ -952,14 +999,14 @@ pub fn fit_relation(
                     .collect()
             }
             // Nothing but linear coefficients to refit, and a plan that does not depend on the
-            // rows: a fold's normal equations are the other subjects' sums, all from one pass.
-            None if n_bp == 0 && lay.subj_col.is_none() && rel.plan(&[]) == plan => {
-                loso_from_subject_sums(rel, &lay, &p, &prep, n_subj)
+            // rows: a fold's sums are the other subjects' sums, all from one pass.
+            _ if n_bp == 0 && (plan_fixed || sorted.is_some()) => {
+                loso_from_subject_sums(rel, &lay, &p, &prep)
                     .into_iter()
                     .flatten()
                     .collect()
             }
-            None => leave_one_group_out(&prep.subject, |train, test| {
+            _ => leave_one_group_out(&prep.subject, |train, test| {
                 let q = refit(rel, &free, &p, Subset::Rows(&prep, train))?;
                 Some(test.iter().map(|&i| sq_err(&q, i)).collect::<Vec<f64>>())
             }),
@@ -1015,7 +1062,7 @@ pub fn fit_relation(
         &prep,
         &values,
         &residuals,
-        lf.leverage.as_slice(),
+        &fit.leverage,
         &pub_res,
         weighted,
         df,
@@ -1027,44 +1074,16 @@ pub fn fit_relation(
 
     // Robust refit.
     let robust = if opts.robust {
-        let h = huber_irls(&problem, HUBER_K, HUBER_MAX_ITER)?;
-        let rout = &g * &h.fit.coef + &shift;
-        let rcov = &g * &h.fit.cov * g.transpose();
-        let mut rc = Vec::new();
-        let mut j = 0;
-        for (i, s) in specs.iter().enumerate() {
-            if s.kind != ParamKind::Linear {
-                continue;
-            }
-            let se = free[i].then(|| rcov[(j, j)].max(0.0).sqrt());
-            rc.push(CoefficientRecord {
-                name: s.name.to_string(),
-                unit: s.unit.to_string(),
-                value: rout[j],
-                std_error: se,
-                ci95: se.map_or([None, None], |se| {
-                    [opt(rout[j] - tq * se), opt(rout[j] + tq * se)]
-                }),
-                published: published[i],
-                t_test: None,
-                ci95_bootstrap: None,
-                held: if free[i] {
-                    None
-                } else {
-                    held_reason[i].clone()
-                },
-                flag: None,
-            });
-            j += 1;
-        }
-        Some(RobustRecord {
-            k: h.k,
-            scale: h.scale,
-            iterations: h.iterations,
-            converged: h.converged,
-            rows_downweighted: h.robust_weights.iter().filter(|&&u| u < 1.0).count(),
-            coefficients: rc,
-        })
+        Some(robust_refit(
+            rel,
+            &lay,
+            &p,
+            &prep,
+            &free,
+            &held_reason,
+            &published,
+            weighted,
+        )?)
     } else {
         None
     };
@@ -1073,18 +1092,43 @@ pub fn fit_relation(
     let bootstrap = if opts.bootstrap > 0 {
         let groups = prep.subject.clone();
         let idx_free: Vec<usize> = (0..specs.len()).filter(|&i| free[i]).collect();
-        let summary = bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
-            let q = match (&sorted, whole_subjects(&prep, rows)) {
-                (Some(sr), Some(m)) => {
-                    refit(rel, &free, &p, Subset::Subjects(sr, Members::List(&m)))
+        let summary = if n_bp == 0 && (plan_fixed || sorted.is_some()) {
+            // Replicates are sums of per-subject records: no pass over the rows.
+            let nes =
+                super::design::subject_normal_equations(rel, &lay, &p, &prep, None, None, n_subj);
+            let sums: Option<Vec<SubjectSums>> = nes
+                .iter()
+                .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
+                .collect();
+            let sums = sums.ok_or_else(|| FitError::Singular {
+                relation: id.clone(),
+                message: "a subject's own slope column is all zeros".into(),
+            })?;
+            bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
+                let m_list = whole_subjects(&prep, rows)?;
+                let mut t = Totals::zeros(lay.m());
+                for (s, mult) in m_list {
+                    t.add(&sums[s], mult);
                 }
-                _ => refit(rel, &free, &p, Subset::Rows(&prep, rows)),
-            }?;
-            Some(idx_free.iter().map(|&i| q[i]).collect())
-        });
+                let (coef, _) = t.solve(&lay)?;
+                let q = lay.params(rel, &p, &coef);
+                Some(idx_free.iter().map(|&i| q[i]).collect())
+            })
+        } else {
+            bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
+                let q = match (&sorted, whole_subjects(&prep, rows)) {
+                    (Some(sr), Some(m)) => {
+                        refit(rel, &free, &p, Subset::Subjects(sr, Members::List(&m)))
+                    }
+                    _ => refit(rel, &free, &p, Subset::Rows(&prep, rows)),
+                }?;
+                Some(idx_free.iter().map(|&i| q[i]).collect())
+            })
+        };
         for (k, &i) in idx_free.iter().enumerate() {
             if summary.n_ok > 1 {
                 coefs[i].ci95_bootstrap = Some(summary.ci95[k]);
+                coefs[i].se_bootstrap = opt(summary.std_dev[k]);
             }
         }
         Some(BootstrapRecord {
@@ -1105,9 +1149,9 @@ pub fn fit_relation(
     notes.push(format!("r² is {r2_def}"));
     if n_bp > 0 {
         notes.push(
-            "breakpoint intervals are profile-likelihood (F-based) intervals with the other \
-             breakpoints held at their estimates; linear standard errors are conditional on the \
-             breakpoint estimates; leave-one-out (PRESS) holds the breakpoints fixed"
+            "breakpoint intervals are the hulls of F-based profile confidence sets (other \
+             breakpoints held at their estimates; see breakpoints for the pieces); leave-one-out \
+             (PRESS) holds the breakpoints fixed"
                 .into(),
         );
     }
@@ -1187,6 +1231,16 @@ pub fn fit_relation(
             levels.insert(s.to_string(), c.value);
         }
     }
+    let band = Band {
+        lay: lay.clone(),
+        coef: fit.coef.clone(),
+        cov: cov.clone(),
+        bps: if cov_f.is_some() {
+            bps.clone()
+        } else {
+            Vec::new()
+        },
+    };
     let record = FitRecord {
         relation: id.clone(),
         title: rel.title().to_string(),
@@ -1197,6 +1251,7 @@ pub fn fit_relation(
         n_subjects: n_subj,
         coefficients: coefs,
         r2,
+        r2_centred: Some(r2c),
         r2_definition: r2_def,
         adj_r2,
         rmse,
@@ -1211,6 +1266,10 @@ pub fn fit_relation(
             rmse: pub_rmse,
         },
         valid_range,
+        outside_range: None,
+        inference: Some(inference),
+        breakpoints: bp_records,
+        bounded: None,
         data: DataRecord {
             path,
             sha256,
@@ -1235,10 +1294,105 @@ pub fn fit_relation(
         fitted,
         residuals,
         values,
-        lay,
-        beta: lf.coef.clone(),
-        cov: cov_beta,
-        df,
+        band,
+    })
+}
+
+/// The Huber refit of the linear coefficients at the breakpoint estimates (dense design: the
+/// per-subject column, if any, as one column per subject).
+#[allow(clippy::too_many_arguments)]
+fn robust_refit(
+    rel: &dyn Relation,
+    lay: &Layout,
+    p: &[f64],
+    prep: &Prepared,
+    free: &[bool],
+    held_reason: &[Option<String>],
+    published: &[f64],
+    weighted: bool,
+) -> Result<RobustRecord, FitError> {
+    let n = prep.obs.len();
+    let n_subj = prep.subjects.len();
+    let m = lay.m();
+    let nfe = if lay.subj_col.is_some() { n_subj } else { 0 };
+    let nc = m + nfe;
+    let mut x = DMatrix::<f64>::zeros(n, nc);
+    let mut y = DVector::<f64>::zeros(n);
+    let mut g = [0.0; MAX_BASIS];
+    for i in 0..n {
+        let (off, z) = lay.row(rel, p, &prep.obs[i].x, &mut g[..m]);
+        for j in 0..m {
+            x[(i, j)] = g[j];
+        }
+        if nfe > 0 {
+            x[(i, m + prep.subject[i])] = z;
+        }
+        y[i] = prep.obs[i].y - off;
+    }
+    let w = DVector::from_vec(prep.weights.clone());
+    let id = rel.id();
+    let mut problem = LinearProblem::new(&x, &y).named(id);
+    if weighted {
+        problem = problem.with_weights(&w);
+    }
+    let h = huber_irls(&problem, HUBER_K, HUBER_MAX_ITER)?;
+    // Design coefficients → basis coefficients (mean slope) → raw linear parameters.
+    let mut e = DMatrix::zeros(lay.nb, nc);
+    let mut gi = 0;
+    for j in 0..lay.nb {
+        if Some(j) == lay.subj_col {
+            for s in 0..n_subj {
+                e[(j, m + s)] = 1.0 / n_subj as f64;
+            }
+        } else {
+            e[(j, gi)] = 1.0;
+            gi += 1;
+        }
+    }
+    let lm = rel.basis_to_params(p, free);
+    let gmap = &lm.map * e;
+    let rout = &gmap * &h.fit.coef + &lm.shift;
+    let rcov = &gmap * &h.fit.cov * gmap.transpose();
+    let df = h.fit.df_resid as f64;
+    let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
+    let mut rc = Vec::new();
+    let mut j = 0;
+    for (i, s) in rel.parameters().iter().enumerate() {
+        if s.kind != ParamKind::Linear {
+            continue;
+        }
+        let se = free[i].then(|| rcov[(j, j)].max(0.0).sqrt());
+        rc.push(CoefficientRecord {
+            name: s.name.to_string(),
+            unit: s.unit.to_string(),
+            value: rout[j],
+            std_error: se,
+            ci95: se.map_or([None, None], |se| {
+                [opt(rout[j] - tq * se), opt(rout[j] + tq * se)]
+            }),
+            published: s.cited.then_some(published[i]),
+            t_test: None,
+            std_error_conditional: None,
+            inference: None,
+            ci95_bootstrap: None,
+            se_bootstrap: None,
+            held: if free[i] {
+                None
+            } else {
+                held_reason[i].clone()
+            },
+            flag: None,
+        });
+        j += 1;
+    }
+    Ok(RobustRecord {
+        k: h.k,
+        scale: h.scale,
+        iterations: h.iterations,
+        converged: h.converged,
+        rows_downweighted: h.robust_weights.iter().filter(|&&u| u < 1.0).count(),
+        cov: None,
+        coefficients: rc,
     })
 }
 
@@ -1324,20 +1478,4 @@ pub fn fit_all(
         }
     }
     run
-}
-
-/// The full XᵀX (row-major nc × nc) from sums accumulated in either triangle (entries are added
-/// in whichever order the columns came; the diagonal once).
-fn symmetric_xtx(nc: usize, acc: &[f64]) -> Vec<f64> {
-    let mut xtx = vec![0.0f64; nc * nc];
-    for a in 0..nc {
-        for b in 0..nc {
-            xtx[a * nc + b] = if a == b {
-                acc[a * nc + a]
-            } else {
-                acc[a * nc + b] + acc[b * nc + a]
-            };
-        }
-    }
-    xtx
 }

@@ -111,7 +111,8 @@ fn sign(i: usize) -> f64 {
     }
 }
 
-/// The parameter table: α published as 0 (the paper gives none), μ* and sl* the bundled
+/// The parameter table: α not published (the paper gives none; 0, the similarity assumption
+/// alone, is the reference value the published relation uses), μ* and sl* the bundled
 /// prototype's. Built once (it reads the bundled prototype).
 fn params() -> &'static [ParameterSpec] {
     static P: OnceLock<Vec<ParameterSpec>> = OnceLock::new();
@@ -121,6 +122,8 @@ fn params() -> &'static [ParameterSpec] {
             name,
             unit: "rad/m",
             published: 0.0,
+            // The paper gives no α (only α₁'s range): no published value, no t-test.
+            cited: false,
             kind: ParamKind::Linear,
             description,
         };
@@ -128,6 +131,7 @@ fn params() -> &'static [ParameterSpec] {
             name: NAMES[4 + k],
             unit: "rad",
             published: proto.mu_star[k],
+            cited: true,
             kind: ParamKind::Linear,
             description,
         };
@@ -135,19 +139,19 @@ fn params() -> &'static [ParameterSpec] {
             alpha(
                 "alpha1",
                 "slope of μ1 (knee flexion at heel strike, decreasing) with x; the paper gives \
-                 only [0, 0.3]; published 0 = the similarity assumption alone",
+                 only [0, 0.3]; reference 0 = the similarity assumption alone",
             ),
             alpha(
                 "alpha2",
-                "slope of μ2 (foot angle at heel strike) with x; published 0 = none",
+                "slope of μ2 (foot angle at heel strike) with x; the paper gives none",
             ),
             alpha(
                 "alpha3",
-                "slope of μ3 (foot angle at toe off) with x; published 0 = none",
+                "slope of μ3 (foot angle at toe off) with x; the paper gives none",
             ),
             alpha(
                 "alpha4",
-                "slope of μ4 (meta angle at toe off) with x; published 0 = none",
+                "slope of μ4 (meta angle at toe off) with x; the paper gives none",
             ),
             star(
                 0,
@@ -169,6 +173,7 @@ fn params() -> &'static [ParameterSpec] {
                 name: "sl_star",
                 unit: "m",
                 published: proto.walk.step_length(),
+                cited: true,
                 kind: ParamKind::Breakpoint,
                 description: "the bundled prototype's step length",
             },
@@ -176,6 +181,7 @@ fn params() -> &'static [ParameterSpec] {
                 name: "ll_star",
                 unit: "m",
                 published: WINTER_TABLE_LEG_LENGTH,
+                cited: true,
                 kind: ParamKind::Breakpoint,
                 description: "Winter's leg length as the trials tables measure it",
             },

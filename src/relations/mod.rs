@@ -135,8 +135,12 @@ pub struct ParameterSpec {
     pub name: &'static str,
     /// Unit in the papers' terms.
     pub unit: &'static str,
-    /// The published value.
+    /// The published value (the relation's value with published coefficients; where the paper
+    /// gives none, see `cited`, a neutral reference such as 0).
     pub published: f64,
+    /// Whether the paper gives `published`; when not, fits report no published value and no
+    /// t-test against it.
+    pub cited: bool,
     /// Linear or breakpoint.
     pub kind: ParamKind,
     /// What it is.

@@ -31,6 +31,7 @@ const PARAMS: &[ParameterSpec] = &[ParameterSpec {
     name: "k",
     unit: "m per (step/min · m)",
     published: 0.004,
+    cited: true,
     kind: ParamKind::Linear,
     description: "step length per step frequency per body height",
 }];

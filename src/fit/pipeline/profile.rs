@@ -27,7 +27,9 @@
 //!   found are discarded and the rest bisected. The estimate is the midpoint of the optimal gap,
 //!   and its interval ends are data keys (where the partition changes).
 //! - Two breakpoints are profiled by coordinate descent.
-use super::{solve_ne, solve_normal, Layout, Prepared};
+use super::Prepared;
+use crate::export::coeffs::BreakpointRecord;
+use crate::fit::design::{solve_rows, Layout, SubjectSums, Totals};
 use crate::fit::nonlinear::minimize_1d;
 use crate::fit::prec::MIN1D_GRID;
 use crate::fit::FitError;
@@ -44,9 +46,6 @@ use std::sync::OnceLock;
 /// partition found (with a note): reached only by a profile that is flat over a great many
 /// partitions (no knot in the data).
 pub const DISCRETE_MAX_EVALS: usize = 20_000;
-/// Partitions walked one by one from the estimate when locating a discrete breakpoint's
-/// interval ends; beyond, the walk doubles its steps and bisects the first crossing.
-const DISCRETE_WALK: usize = 256;
 
 /// Rows per leaf of a [`Tree`]: leaves partly inside a queried interval are summed row by row.
 const LEAF: usize = 8;
@@ -535,14 +534,11 @@ fn solve_sorted(
     members: Members,
     remove: Option<(f64, f64)>,
 ) -> Option<(DVector<f64>, f64)> {
-    let nc = lay.ncols();
-    let mut xtx = vec![0.0; nc * nc];
-    let mut xty = vec![0.0; nc];
-    let mut yty = 0.0;
     match lay.subj_col {
-        // Per-subject slope columns: each subject's normal equations land in its own column.
-        Some(sc) => {
-            for (m, (s, mult)) in members.list(sr.subj.len()).into_iter().enumerate() {
+        // A per-subject column: each subject's normal equations, that column absorbed, summed.
+        Some(_) => {
+            let mut t = Totals::zeros(lay.m());
+            for (s, mult) in members.list(sr.subj.len()) {
                 let one = [(s, 1.0)];
                 let q = Query {
                     sr,
@@ -556,20 +552,9 @@ fn solve_sorted(
                 if ne.nb != lay.nb {
                     return None;
                 }
-                let col = |j: usize| match j.cmp(&sc) {
-                    std::cmp::Ordering::Equal => lay.nb - 1 + m,
-                    std::cmp::Ordering::Greater => j - 1,
-                    std::cmp::Ordering::Less => j,
-                };
-                for a in 0..ne.nb {
-                    let ca = col(a);
-                    xty[ca] += mult * ne.xty[a];
-                    for b in 0..ne.nb {
-                        xtx[ca * nc + col(b)] += mult * ne.xtx[a * ne.nb + b];
-                    }
-                }
-                yty += mult * ne.yty;
+                t.add(&SubjectSums::absorb(&ne, lay.subj_col)?, mult);
             }
+            t.solve(lay)
         }
         None => {
             let q = Query {
@@ -581,15 +566,14 @@ fn solve_sorted(
                 .ctx
                 .form
                 .normal_equations(p, &lay.free, &sr.ctx.scale, &q);
-            if ne.nb != nc {
+            if ne.nb != lay.nb {
                 return None;
             }
-            xtx.copy_from_slice(&ne.xtx);
-            xty.copy_from_slice(&ne.xty);
-            yty = ne.yty;
+            let mut t = Totals::zeros(lay.m());
+            t.add(&SubjectSums::absorb(&ne, None)?, 1.0);
+            t.solve(lay)
         }
     }
-    solve_normal(nc, &xtx, &xty, yty)
 }
 
 /// Where the rows of a profile come from.
@@ -600,6 +584,7 @@ pub(super) enum Source<'b> {
         prep: &'b Prepared,
         rows: Option<&'b [usize]>,
         subj_map: Option<&'b [usize]>,
+        n_subj: usize,
     },
     /// Trees over the rows sorted by key; `keys` are the members' rows' distinct keys.
     Sorted {
@@ -624,7 +609,8 @@ impl Profiler<'_> {
                 prep,
                 rows,
                 subj_map,
-            } => solve_ne(self.rel, self.lay, p, prep, rows, subj_map),
+                n_subj,
+            } => solve_rows(self.rel, self.lay, p, prep, rows, subj_map, n_subj),
             Source::Sorted { sr, members, .. } => solve_sorted(sr, self.lay, p, members, None),
         }
     }
@@ -776,70 +762,62 @@ impl Discrete<'_> {
         best.0.is_finite().then(|| self.value(best.1))
     }
 
-    /// The profile interval's ends: the data keys where the partition's RSS first exceeds
-    /// `thr`, walking out from the estimate; `None` when it stays below within `[lo, hi]`.
-    fn interval(&self, p: &[f64], lo: f64, hi: f64, thr: f64) -> (Option<f64>, Option<f64>) {
-        let Some((j0, j1)) = self.candidates(lo, hi) else {
-            return (None, None);
-        };
-        let est = self.keys.partition_point(|&d| d < p[self.i]).clamp(j0, j1);
-        let above = |j: usize| self.rss(p, j) > thr;
-        // First rejected partition stepping by `dir` from `est` within [j0, j1].
-        let first_out = |down: bool| -> Option<usize> {
-            let step = |j: usize, d: usize| -> Option<usize> {
-                if down {
-                    j.checked_sub(d).filter(|&k| k >= j0)
-                } else {
-                    Some(j + d).filter(|&k| k <= j1)
+    /// The F confidence set over every admissible partition in `[lo, hi]`: the partitions
+    /// whose RSS is at most `thr`, found exactly by branch and bound (a range of partitions
+    /// whose lower bound exceeds `thr` is rejected whole; the others are split down to single
+    /// partitions, which are evaluated).
+    fn confidence_set(&self, p: &[f64], lo: f64, hi: f64, thr: f64) -> Option<ConfidenceSet> {
+        let (j0, j1) = self.candidates(lo, hi)?;
+        let mut accepted: Vec<(usize, f64)> = Vec::new();
+        let mut stack = vec![(j0, j1)];
+        while let Some((a, b)) = stack.pop() {
+            if a == b {
+                let r = self.rss(p, a);
+                if r <= thr {
+                    accepted.push((a, r));
                 }
-            };
-            let mut inside = est;
-            for _ in 0..DISCRETE_WALK {
-                let j = step(inside, 1)?;
-                if above(j) {
-                    return Some(j);
-                }
-                inside = j;
+                continue;
             }
-            // Doubling steps, then bisect between the last inside and the first outside.
-            let mut d = 2;
-            loop {
-                let j = match step(inside, d) {
-                    Some(j) => j,
-                    None => {
-                        let end = if down { j0 } else { j1 };
-                        if end == inside || !above(end) {
-                            return None;
-                        }
-                        end
-                    }
-                };
-                if above(j) {
-                    let (mut a, mut b) = (inside, j);
-                    while a.abs_diff(b) > 1 {
-                        let m = if down {
-                            b + (a - b) / 2
-                        } else {
-                            a + (b - a) / 2
-                        };
-                        if above(m) {
-                            b = m;
-                        } else {
-                            a = m;
-                        }
-                    }
-                    return Some(b);
-                }
-                inside = j;
-                d *= 2;
+            if self.lower_bound(p, a, b) > thr {
+                continue;
             }
-        };
-        // Rejected partition j below: accepted values start above keys[j]; above: they end at
-        // keys[j − 1].
-        (
-            first_out(true).map(|j| self.keys[j]),
-            first_out(false).map(|j| self.keys[j - 1]),
-        )
+            let m = a + (b - a) / 2;
+            stack.push((a, m));
+            stack.push((m + 1, b));
+        }
+        accepted.sort_by_key(|a| a.0);
+        let mut pieces = Vec::new();
+        let mut minima = 0;
+        let mut k = 0;
+        while k < accepted.len() {
+            let mut e = k;
+            while e + 1 < accepted.len() && accepted[e + 1].0 == accepted[e].0 + 1 {
+                e += 1;
+            }
+            // Partition j holds every value in (keys[j − 1], keys[j]].
+            let (a, b) = (accepted[k].0, accepted[e].0);
+            pieces.push([
+                (a > j0).then(|| self.keys[a - 1]),
+                (b < j1).then(|| self.keys[b]),
+            ]);
+            for q in k..=e {
+                let r = accepted[q].1;
+                let left = q == k || accepted[q - 1].1 > r;
+                let right = q == e || accepted[q + 1].1 >= r;
+                if left && right {
+                    minima += 1;
+                }
+            }
+            k = e + 1;
+        }
+        Some(ConfidenceSet {
+            discrete: true,
+            admissible: j1 - j0 + 1,
+            accepted: accepted.len(),
+            pieces,
+            local_minima: minima,
+            minima_in_set: minima,
+        })
     }
 }
 
@@ -886,59 +864,173 @@ pub(super) fn profile(
     Ok(p)
 }
 
-/// The profile-likelihood interval of breakpoint `i`: the values where
-/// RSS(θ) = RSS_min·(1 + F(1, df; 0.95)/df), searched within the bracket; `None` = open.
-pub(super) fn profile_interval(
+/// Cells of the grid over a continuous breakpoint's whole search range on which its profile
+/// is evaluated for the confidence set (and its local minima counted): fine enough to resolve
+/// a set a few tenths of a percent of the range wide; each crossing is then bisected.
+pub const PROFILE_GRID: usize = 256;
+
+/// A breakpoint's 95 % confidence set from its profile.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct ConfidenceSet {
+    /// The model depends on the breakpoint only through which rows lie on each side.
+    discrete: bool,
+    /// Partitions (discrete) or grid values examined.
+    admissible: usize,
+    /// Of those, accepted.
+    accepted: usize,
+    /// Pieces `[lo, hi]`; `None` where a piece reaches the end of the admissible range.
+    pieces: Vec<[Option<f64>; 2]>,
+    /// Local minima of the profile over the admissible range.
+    local_minima: usize,
+    /// Local minima inside the set.
+    minima_in_set: usize,
+}
+
+impl ConfidenceSet {
+    /// The record and the hull (the reported `ci95`).
+    pub fn record(&self, name: &str) -> (BreakpointRecord, [Option<f64>; 2]) {
+        let hull = match (self.pieces.first(), self.pieces.last()) {
+            (Some(a), Some(b)) => [a[0], b[1]],
+            _ => [None, None],
+        };
+        let why = if self.discrete {
+            Some(format!(
+                "the model jumps at {name}, so the residual sum of squares is a step function of \
+                 it: no derivative, no Wald standard error (the estimate converges at rate n, \
+                 with a non-normal limit)"
+            ))
+        } else if self.pieces.len() != 1 {
+            Some(format!(
+                "the confidence set has {} separate pieces",
+                self.pieces.len()
+            ))
+        } else if hull[0].is_none() || hull[1].is_none() {
+            Some("the confidence set reaches the end of the admissible range".into())
+        } else if self.minima_in_set > 1 {
+            Some(format!(
+                "the profile has {} local minima inside the confidence set",
+                self.minima_in_set
+            ))
+        } else {
+            None
+        };
+        let method = if self.discrete {
+            format!(
+                "F-test of the profile residual sum of squares against its minimum, over all {} \
+                 admissible partitions of the rows (exact: branch and bound)",
+                self.admissible
+            )
+        } else {
+            format!(
+                "F-test of the profile residual sum of squares against its minimum, on a grid of \
+                 {} values over the whole search range (crossings bisected)",
+                self.admissible
+            )
+        };
+        (
+            BreakpointRecord {
+                name: name.to_string(),
+                method,
+                admissible: self.admissible,
+                accepted: self.accepted,
+                pieces: self.pieces.clone(),
+                local_minima: self.local_minima,
+                regular: why.is_none(),
+                irregular_because: why,
+            },
+            hull,
+        )
+    }
+}
+
+/// The 95 % confidence set of breakpoint `i` (the others held at `p`): the values where the
+/// profile RSS ≤ `thr` = RSS_min·(1 + F(1, df; 0.95)/df), over every admissible partition of
+/// the rows (discrete breakpoints) or a [`PROFILE_GRID`] grid over the whole search range.
+pub(super) fn confidence_set(
     pr: &Profiler,
     p: &[f64],
     i: usize,
     search: &[Option<(f64, f64)>],
-    df: f64,
-    tq: f64,
-) -> (Option<f64>, Option<f64>) {
-    let Some((lo, hi)) = search[i] else {
-        return (None, None);
+    thr: f64,
+) -> ConfidenceSet {
+    let empty = ConfidenceSet {
+        discrete: pr.discrete(i).is_some(),
+        admissible: 0,
+        accepted: 0,
+        pieces: Vec::new(),
+        local_minima: 0,
+        minima_in_set: 0,
     };
-    let rmin = pr.rss(p);
-    let thr = rmin * (1.0 + tq * tq / df);
+    let Some((lo, hi)) = search[i] else {
+        return empty;
+    };
     if let Some(d) = pr.discrete(i) {
-        return d.interval(p, lo, hi, thr);
+        return d.confidence_set(p, lo, hi, thr).unwrap_or(empty);
     }
     let rss = |t: f64| pr.rss_at(p, i, t);
-    // Step outward geometrically (narrow intervals on large data are found in a few steps),
-    // then bisect to 0.1 % of the half-width.
-    let find = |end: f64| -> Option<f64> {
-        let span = end - p[i];
-        if span == 0.0 {
-            return None;
-        }
-        let mut inside = p[i];
-        let mut frac: f64 = 1e-4;
-        loop {
-            let t = p[i] + span * frac.min(1.0);
-            if rss(t) > thr {
-                let (mut a, mut b) = (inside, t);
-                for _ in 0..40 {
-                    if (b - a).abs() <= 1e-3 * (b - p[i]).abs() {
-                        break;
-                    }
-                    let m = 0.5 * (a + b);
-                    if rss(m) > thr {
-                        b = m;
-                    } else {
-                        a = m;
-                    }
-                }
-                return Some(0.5 * (a + b));
+    let cells = PROFILE_GRID;
+    let mut ts: Vec<f64> = (0..=cells)
+        .map(|c| lo + (hi - lo) * c as f64 / cells as f64)
+        .collect();
+    if p[i] > lo && p[i] < hi {
+        ts.push(p[i]);
+        ts.sort_by(f64::total_cmp);
+        ts.dedup();
+    }
+    let r: Vec<f64> = ts.iter().map(|&t| rss(t)).collect();
+    let ok: Vec<bool> = r.iter().map(|&v| v <= thr).collect();
+    let tol = 1e-3 * (hi - lo) / cells as f64;
+    // The crossing between an accepted `a` and a rejected `b`.
+    let cross = |a: f64, b: f64| {
+        let (mut a, mut b) = (a, b);
+        while (b - a).abs() > tol {
+            let m = 0.5 * (a + b);
+            if rss(m) <= thr {
+                a = m;
+            } else {
+                b = m;
             }
-            if frac >= 1.0 {
-                return None;
-            }
-            inside = t;
-            frac *= 2.0;
         }
+        0.5 * (a + b)
     };
-    (find(lo), find(hi))
+    let n = ts.len();
+    let mut pieces = Vec::new();
+    let mut k = 0;
+    while k < n {
+        if !ok[k] {
+            k += 1;
+            continue;
+        }
+        let mut e = k;
+        while e + 1 < n && ok[e + 1] {
+            e += 1;
+        }
+        pieces.push([
+            (k > 0).then(|| cross(ts[k], ts[k - 1])),
+            (e + 1 < n).then(|| cross(ts[e], ts[e + 1])),
+        ]);
+        k = e + 1;
+    }
+    let mut minima = 0;
+    let mut in_set = 0;
+    for c in 0..n {
+        let left = c == 0 || r[c - 1] > r[c];
+        let right = c + 1 == n || r[c + 1] >= r[c];
+        if left && right {
+            minima += 1;
+            if ok[c] {
+                in_set += 1;
+            }
+        }
+    }
+    ConfidenceSet {
+        discrete: false,
+        admissible: n,
+        accepted: ok.iter().filter(|&&v| v).count(),
+        pieces,
+        local_minima: minima,
+        minima_in_set: in_set,
+    }
 }
 
 /// The rows of a refit (cross-validation, bootstrap).
@@ -1027,6 +1119,7 @@ pub(super) fn refit(
             prep,
             rows: Some(rows),
             subj_map: Some(&map),
+            n_subj,
         },
         Subset::Subjects(sr, members) => Source::Sorted {
             sr,
@@ -1040,18 +1133,8 @@ pub(super) fn refit(
         src,
     };
     let p = profile(&pr, p_start, &search, &mut Vec::new()).ok()?;
-    let (beta, _) = pr.solve(&p)?;
-    let (g, shift) = lay.output_map(rel, &p);
-    let out = &g * &beta + &shift;
-    let mut full = p.clone();
-    let mut j = 0;
-    for (i, s) in rel.parameters().iter().enumerate() {
-        if s.kind == ParamKind::Linear {
-            full[i] = out[j];
-            j += 1;
-        }
-    }
-    Some(full)
+    let (coef, _) = pr.solve(&p)?;
+    Some(lay.params(rel, &p, &coef))
 }
 
 #[cfg(test)]

@@ -1,0 +1,220 @@
+//! Standard errors, degrees of freedom and breakpoint confidence sets of `gaitfit fit` on the
+//! bundled `data/*.csv` against independent computations.
+//!
+//! Source of every expected number: `tools/reference/inference.json`, written by
+//! `tools/reference/inference.py` (statsmodels 0.15 `OLS.fit(cov_type='cluster', use_t=True)`
+//! for CR1; dense numpy implementations of CR2 with n_g × n_g adjustment matrices and of the
+//! Bell–McCaffrey degrees of freedom from GᵀG; the F set of k1 by fitting every admissible
+//! partition; the clustered standard error of a mean of subject slopes from the dense design).
+//! Regenerate with `/work/venv/bin/python tools/reference/inference.py` after `data/` changes.
+use gaitfit::export::coeffs::FitRecord;
+use gaitfit::fit::inference::SeMethod;
+use gaitfit::fit::pipeline::{fit_relation, load_tables, FitOptions};
+use gaitfit::ingest::trials::TrialsTable;
+use gaitfit::relations::by_id;
+use serde_json::Value;
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn reference() -> Value {
+    let p = root().join("tools/reference/inference.json");
+    serde_json::from_str(&std::fs::read_to_string(&p).expect("reference file")).expect("json")
+}
+
+fn bundled() -> Vec<TrialsTable> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(root().join("data"))
+        .expect("data/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "csv"))
+        .collect();
+    files.sort();
+    load_tables(&files, None).expect("bundled data")
+}
+
+fn fit(tables: &[TrialsTable], id: &str, se: SeMethod) -> FitRecord {
+    let rel = by_id(id).expect("relation");
+    let opts = FitOptions {
+        se: Some(se),
+        ..FitOptions::default()
+    };
+    fit_relation(rel.as_ref(), tables, &opts)
+        .expect("fit")
+        .record
+}
+
+fn close(got: f64, want: f64, rel: f64, what: &str) {
+    let err = (got - want).abs() / want.abs().max(1e-300);
+    assert!(
+        err <= rel,
+        "{what}: gaitfit {got:e} vs reference {want:e} (rel {err:e})"
+    );
+}
+
+fn num(v: &Value) -> f64 {
+    v.as_f64().expect("number")
+}
+
+fn nums(v: &Value) -> Vec<f64> {
+    v.as_array().expect("array").iter().map(num).collect()
+}
+
+fn coef<'a>(r: &'a FitRecord, name: &str) -> &'a gaitfit::export::coeffs::CoefficientRecord {
+    r.coefficient(name)
+        .unwrap_or_else(|| panic!("{}: no {name}", r.relation))
+}
+
+/// Linear relations without breakpoints: coefficients, iid / CR1 / CR2 standard errors and the
+/// degrees of freedom of each method.
+#[test]
+fn linear_relations_match_statsmodels_and_dense_cr2() {
+    let tables = bundled();
+    let refs = reference();
+    for (id, names) in [
+        ("walk-tds-sf", &["d0", "d1"][..]),
+        ("walk-sl-sf", &["k"][..]),
+    ] {
+        let want = &refs[id];
+        for (method, se_key, df) in [
+            (SeMethod::Iid, "se_iid", None),
+            (SeMethod::Cluster, "se_cr1", Some(num(&want["df_cr1"]))),
+            (SeMethod::Cr2, "se_cr2", None),
+        ] {
+            let r = fit(&tables, id, method);
+            assert_eq!(r.n as f64, num(&want["n"]), "{id} n");
+            assert_eq!(r.n_subjects as f64, num(&want["clusters"]), "{id} G");
+            let inf = r.inference.as_ref().expect("inference record");
+            assert_eq!(inf.method, method.label());
+            for (j, name) in names.iter().enumerate() {
+                let c = coef(&r, name);
+                let what = format!("{id} {name} {}", method.label());
+                close(c.value, nums(&want["coef"])[j], 1e-10, &what);
+                let se = c.std_error.expect("se");
+                close(se, nums(&want[se_key])[j], 1e-9, &format!("{what} se"));
+                let t = c.t_test.as_ref().expect("t-test");
+                match method {
+                    SeMethod::Iid => assert_eq!(t.df, (r.n - names.len()) as f64),
+                    SeMethod::Cluster => assert_eq!(Some(t.df), df),
+                    SeMethod::Cr2 => {
+                        close(t.df, nums(&want["df_cr2"])[j], 1e-8, &format!("{what} df"))
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// k1 of the flight-time relation: the F set over all admissible partitions (pieces, counts)
+/// and the linear coefficients' CR1 standard errors conditional on k1.
+#[test]
+fn flight_time_knot_set_and_conditional_cr1() {
+    let tables = bundled();
+    let want = &reference()["run-tflight-sf"];
+    let r = fit(&tables, "run-tflight-sf", SeMethod::Cluster);
+    let k1 = coef(&r, "k1");
+    close(k1.value, num(&want["k1"]), 1e-12, "k1");
+    let bp = r
+        .breakpoints
+        .iter()
+        .find(|b| b.name == "k1")
+        .expect("k1 set");
+    assert_eq!(bp.admissible as f64, num(&want["k1_admissible"]));
+    assert_eq!(bp.accepted as f64, num(&want["k1_accepted"]));
+    let pieces = want["k1_pieces"].as_array().expect("pieces");
+    assert_eq!(bp.pieces.len(), pieces.len(), "{:?}", bp.pieces);
+    for (got, want) in bp.pieces.iter().zip(pieces) {
+        for e in 0..2 {
+            match (got[e], want[e].as_f64()) {
+                (Some(g), Some(w)) => close(g, w, 1e-12, "k1 piece end"),
+                (None, None) => {}
+                (g, w) => panic!("k1 piece end {g:?} vs {w:?}"),
+            }
+        }
+    }
+    // The figure: the set covers 152–173 steps/min; the estimate has no standard error.
+    assert!(k1.ci95[0].is_some_and(|v| v <= 152.0) && k1.ci95[1].is_some_and(|v| v >= 172.9));
+    assert!(k1.std_error.is_none() && k1.t_test.is_none() && !bp.regular);
+    for (j, name) in ["q0", "q1", "q2", "c0", "c1", "c2", "c3"]
+        .iter()
+        .enumerate()
+    {
+        let c = coef(&r, name);
+        close(c.value, nums(&want["coef"])[j], 1e-8, name);
+        close(
+            c.std_error.expect("se"),
+            nums(&want["se_cr1_conditional"])[j],
+            1e-7,
+            &format!("{name} se"),
+        );
+        assert_eq!(c.t_test.as_ref().map(|t| t.df), Some(5.0));
+    }
+}
+
+/// run-sl-v: v_norm from the profile, a and the mean slope b with per-subject slopes absorbed,
+/// their CR1 standard errors conditional on v_norm and with v_norm free, the levels' iid ones.
+#[test]
+fn step_length_with_subject_slopes_matches_the_dense_design() {
+    let tables = bundled();
+    let want = &reference()["run-sl-v"];
+    let r = fit(&tables, "run-sl-v", SeMethod::Cluster);
+    close(
+        coef(&r, "v_norm").value,
+        num(&want["v_norm"]),
+        1e-7,
+        "v_norm",
+    );
+    close(coef(&r, "a").value, num(&want["a"]), 1e-7, "a");
+    close(coef(&r, "b").value, num(&want["b"]), 1e-7, "b");
+    let a = coef(&r, "a");
+    let b = coef(&r, "b");
+    close(
+        a.std_error_conditional.expect("cond"),
+        num(&want["se_a_cr1"]),
+        1e-6,
+        "se a",
+    );
+    close(
+        b.std_error_conditional.expect("cond"),
+        num(&want["se_b_cr1"]),
+        1e-6,
+        "se b",
+    );
+    close(
+        a.std_error.expect("free"),
+        num(&want["se_a_cr1_free"]),
+        1e-6,
+        "se a free",
+    );
+    close(
+        b.std_error.expect("free"),
+        num(&want["se_b_cr1_free"]),
+        1e-6,
+        "se b free",
+    );
+    let vn = coef(&r, "v_norm");
+    close(
+        vn.std_error.expect("v_norm se"),
+        num(&want["se_v_norm_cr1_free"]),
+        1e-6,
+        "se v_norm",
+    );
+    let subjects: Vec<&str> = want["subjects"]
+        .as_array()
+        .expect("subjects")
+        .iter()
+        .map(|s| s.as_str().expect("name"))
+        .collect();
+    for (s, name) in subjects.iter().enumerate() {
+        let l = coef(&r, &format!("level[{name}]"));
+        close(l.value, nums(&want["levels"])[s], 1e-6, name);
+        close(
+            l.std_error.expect("se"),
+            nums(&want["se_levels_iid"])[s],
+            1e-6,
+            name,
+        );
+        assert!(l.published.is_none() && l.t_test.is_none());
+    }
+}

@@ -1,0 +1,241 @@
+"""Reference standard errors and breakpoint confidence sets for `tests/reference_inference.rs`.
+
+Data: the bundled trials tables `data/*.csv` (committed), read as gaitfit reads them
+(`common.py`). Sources: statsmodels OLS with `cov_type='cluster'` (CR1, `use_t=True`: t with
+G − 1 df), and dense numpy implementations written from the definitions for what statsmodels
+lacks (CR2 with Bell–McCaffrey degrees of freedom: n_g × n_g adjustment matrices; the
+F-based confidence set of a breakpoint by fitting every admissible partition; the clustered
+standard error of a mean of per-subject slopes). Nothing here reads gaitfit's output.
+
+Run: /work/venv/bin/python tools/reference/inference.py  (writes tools/reference/inference.json)
+"""
+import json
+import math
+import os
+
+import numpy as np
+import scipy
+import scipy.optimize
+import scipy.stats
+import statsmodels
+import statsmodels.api as sm
+
+from common import ROOT, bm_df, bundled, cr1, cr2, subject_codes
+
+OUT = os.path.join(os.path.dirname(__file__), "inference.json")
+
+
+def rows(df, gait, cols):
+    d = df[(df.gait == gait) & (~df.flagged)]
+    return d.dropna(subset=cols).reset_index(drop=True)
+
+
+def linear(x, y, g):
+    """OLS with iid, CR1 (statsmodels) and CR2 (dense) standard errors and BM df."""
+    ols = sm.OLS(y, x).fit()
+    cl = sm.OLS(y, x).fit(cov_type="cluster", cov_kwds={"groups": g}, use_t=True)
+    v2, adj, m = cr2(x, ols.resid, g)
+    p = x.shape[1]
+    df2 = [bm_df(x, g, adj, m, np.eye(p)[j]) for j in range(p)]
+    return {
+        "n": int(len(y)),
+        "clusters": int(g.max() + 1),
+        "coef": list(ols.params),
+        "se_iid": list(ols.bse),
+        "se_cr1": list(cl.bse),
+        "df_cr1": float(cl.df_resid_inference),
+        "se_cr2": list(np.sqrt(np.diag(v2))),
+        "df_cr2": df2,
+    }
+
+
+def centred_to_raw(deg, c, s):
+    """T with raw = T · β for the basis ((x − c)/s)^i."""
+    t = np.zeros((deg + 1, deg + 1))
+    for i in range(deg + 1):
+        for k in range(i + 1):
+            t[k, i] = math.comb(i, k) * (-c) ** (i - k) / s ** i
+    return t
+
+
+def tflight(df):
+    d = rows(df, "run", ["sf", "tf"])
+    x = d.sf.values * 60.0
+    y = d.tf.values
+    g, _ = subject_codes(d.subject)
+    keys = np.unique(x)
+    nk = len(keys)
+    min_distinct = 5  # RunTflightSf::MIN_DISTINCT: 5 distinct step frequencies per piece
+
+    def design(j):
+        below = x < keys[j]
+        # Centred, scaled pieces (quadratic below, cubic above; k2 = 230 lies above the data).
+        c1, s1 = keys[j] - 25.0, 25.0
+        c2, s2 = (keys[j] + 230.0) / 2.0, (230.0 - keys[j]) / 2.0
+        u = (x - c1) / s1
+        w = (x - c2) / s2
+        cols = [below * 1.0, below * u, below * u ** 2,
+                ~below * 1.0, ~below * w, ~below * w ** 2, ~below * w ** 3]
+        tmat = np.zeros((7, 7))
+        tmat[:3, :3] = centred_to_raw(2, c1, s1)
+        tmat[3:, 3:] = centred_to_raw(3, c2, s2)
+        return np.array(cols).T, tmat
+
+    def rss(j):
+        xd, _ = design(j)
+        beta, *_ = np.linalg.lstsq(xd, y, rcond=None)
+        e = y - xd @ beta
+        return float(e @ e)
+
+    # Admissible partitions: at least 5 distinct keys on each side (the search bracket
+    # [keys[4], keys[n − 5]] of RunTflightSf::plan_sorted; partition j puts keys < keys[j] below).
+    js = list(range(min_distinct, nk - min_distinct + 1))
+    r = np.array([rss(j) for j in js])
+    n = len(y)
+    k = 8  # 7 linear coefficients and k1 (k2 held)
+    dfr = n - k
+    fq = scipy.stats.f.ppf(0.95, 1, dfr)
+    thr = r.min() * (1.0 + fq / dfr)
+    best = js[int(np.argmin(r))]
+    acc = [j for j, v in zip(js, r) if v <= thr]
+    pieces = []
+    i = 0
+    while i < len(acc):
+        e = i
+        while e + 1 < len(acc) and acc[e + 1] == acc[e] + 1:
+            e += 1
+        a, b = acc[i], acc[e]
+        pieces.append([None if a == js[0] else float(keys[a - 1]),
+                       None if b == js[-1] else float(keys[b])])
+        i = e + 1
+    # Linear coefficients at the estimate (midpoint of the best gap), CR1 conditional on k1.
+    xd, tmat = design(best)
+    cl = sm.OLS(y, xd).fit(cov_type="cluster", cov_kwds={"groups": g}, use_t=True)
+    raw = tmat @ cl.params
+    vraw = tmat @ cl.cov_params() @ tmat.T
+    return {
+        "n": int(n),
+        "clusters": int(g.max() + 1),
+        "k1": float(0.5 * (keys[best - 1] + keys[best])),
+        "k1_admissible": len(js),
+        "k1_accepted": len(acc),
+        "k1_pieces": pieces,
+        "coef": list(raw),
+        "se_cr1_conditional": list(np.sqrt(np.diag(vraw))),
+    }
+
+
+def run_sl_v(df):
+    d = rows(df, "run", ["v", "sl", "h"])
+    d = d[d.h > 0].reset_index(drop=True)
+    v = d.v.values * 60.0
+    h = d.h.values
+    y = d.sl.values
+    r = np.sqrt(h / 1.8)
+    g, names = subject_codes(d.subject)
+    G = g.max() + 1
+    n = len(y)
+    onehot = np.eye(G)[g]
+
+    def design(t):
+        z = np.minimum(v, t * r) * r
+        return np.column_stack([np.ones(n), onehot * z[:, None]])
+
+    def rss(t):
+        x = design(t)
+        beta, *_ = np.linalg.lstsq(x, y, rcond=None)
+        e = y - x @ beta
+        return float(e @ e)
+
+    u = np.unique(v / r)
+    lo, hi = u[2], u[-3]  # RunSlV::plan_sorted: 3 distinct normalised speeds on each side
+    grid = np.linspace(lo, hi, 20001)
+    rg = np.array([rss(t) for t in grid])
+    i = int(np.argmin(rg))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    opt = scipy.optimize.minimize_scalar(rss, bounds=(a, b), method="bounded",
+                                         options={"xatol": 1e-10})
+    t = float(opt.x)
+    x = design(t)
+    fit = sm.OLS(y, x).fit()
+    e = fit.resid
+    K = 1 + G  # linear columns of the design
+    cl = sm.OLS(y, x).fit(cov_type="cluster", cov_kwds={"groups": g}, use_t=True)
+    gam = fit.params[1:]
+    gbar = gam.mean()
+    minv = np.linalg.inv(x.T @ x)
+    ell = np.concatenate([[0.0], np.full(G, 1.0 / G)])
+    # The clustered influence of a mean of subject slopes: the full-design influence of the
+    # contrast plus each subject's slope deviation (its between-subject part).
+    c1 = G / (G - 1) * (n - 1) / (n - K)
+    psi = []
+    for c in range(G):
+        sc = x[g == c].T @ e[g == c]
+        psi.append(ell @ minv @ sc + (gam[c] - gbar) / G)
+    se_b = math.sqrt(c1 * sum(p * p for p in psi))
+    # Levels: iid within subject, σ² = RSS/(n − K − 1) (v_norm counted).
+    sigma2 = float(e @ e) / (n - K - 1)
+    se_lev = []
+    for s in range(G):
+        ls = np.zeros(K)
+        ls[1:] = -1.0 / G
+        ls[1 + s] += 1.0
+        se_lev.append(math.sqrt(sigma2 * ls @ minv @ ls))
+    # With v_norm free: Gauss–Newton column ∂sl/∂v_norm = (b + level)·r² on the plateau.
+    jac = np.where(v > t * r, gam[g] * r * r, 0.0)
+    xa = np.column_stack([x, jac])
+    ma = np.linalg.inv(xa.T @ xa)
+    ka = K + 1
+    c1a = G / (G - 1) * (n - 1) / (n - ka)
+    meat = np.zeros((ka, ka))
+    psib = []
+    ella = np.concatenate([ell, [0.0]])
+    for c in range(G):
+        sc = xa[g == c].T @ e[g == c]
+        pc = ma @ sc
+        meat += np.outer(pc, pc)
+        psib.append(ella @ pc + (gam[c] - gbar) / G)
+    va = c1a * meat
+    return {
+        "n": int(n),
+        "clusters": int(G),
+        "subjects": names,
+        "v_norm": t,
+        "a": float(fit.params[0]),
+        "b": float(gbar),
+        "levels": list(gam - gbar),
+        "se_a_cr1": float(cl.bse[0]),
+        "se_b_cr1": se_b,
+        "se_levels_iid": se_lev,
+        "se_a_cr1_free": float(math.sqrt(va[0, 0])),
+        "se_b_cr1_free": float(math.sqrt(c1a * sum(p * p for p in psib))),
+        "se_v_norm_cr1_free": float(math.sqrt(va[K, K])),
+    }
+
+
+def main():
+    df = bundled()
+    out = {
+        "source": "statsmodels OLS cov_type='cluster' (CR1, use_t) and dense numpy CR2 / "
+        "Bell–McCaffrey df / exhaustive partition F sets; data/*.csv",
+        "script": "tools/reference/inference.py",
+        "versions": {"statsmodels": statsmodels.__version__, "numpy": np.__version__,
+                     "scipy": scipy.__version__},
+    }
+    d = rows(df, "walk", ["sf", "ds_pct"])
+    g, _ = subject_codes(d.subject)
+    out["walk-tds-sf"] = linear(np.column_stack([np.ones(len(d)), d.sf.values * 60.0]),
+                                d.ds_pct.values, g)
+    d = rows(df, "walk", ["sl", "sf", "h"])
+    g, _ = subject_codes(d.subject)
+    out["walk-sl-sf"] = linear((d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values, g)
+    out["run-tflight-sf"] = tflight(df)
+    out["run-sl-v"] = run_sl_v(df)
+    with open(OUT, "w") as f:
+        json.dump(out, f, indent=1)
+        f.write("\n")
+    print(json.dumps(out, indent=1)[:3000])
+
+
+if __name__ == "__main__":
+    main()
