@@ -30,6 +30,14 @@ fn value(rec: &gaitfit::export::coeffs::FitRecord, name: &str) -> f64 {
 /// (x, μ) points of μ `i` read straight from the CSV text (degrees → rad), independently of the
 /// trials reader and the relation.
 fn points_from_csv(path: &Path, i: usize) -> Vec<(f64, f64)> {
+    subject_points_from_csv(path, i)
+        .into_iter()
+        .map(|(_, x, y)| (x, y))
+        .collect()
+}
+
+/// As [`points_from_csv`], with each point's subject.
+fn subject_points_from_csv(path: &Path, i: usize) -> Vec<(String, f64, f64)> {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines().filter(|l| !l.starts_with('#'));
     let head: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -41,6 +49,7 @@ fn points_from_csv(path: &Path, i: usize) -> Vec<(f64, f64)> {
         "meta_angle_to_deg",
     ][i]);
     let (sl, ll, gait) = (col("step_length_m"), col("leg_length_m"), col("gait"));
+    let subj = col("subject");
     lines
         .filter_map(|l| {
             let f: Vec<&str> = l.split(',').collect();
@@ -48,7 +57,7 @@ fn points_from_csv(path: &Path, i: usize) -> Vec<(f64, f64)> {
             (f[gait] == "walk").then(|| {
                 let x = f[sl].parse::<f64>().unwrap() * WINTER_TABLE_LEG_LENGTH
                     / f[ll].parse::<f64>().unwrap();
-                (x, m.to_radians())
+                (f[subj].to_string(), x, m.to_radians())
             })
         })
         .collect()
@@ -106,19 +115,46 @@ fn bounded_fit_equals_clamped_separable_lines() {
         1.0 - rss / tss
     );
     assert!(rec.derived.iter().any(|d| d.name == "mu4: r² (centred)"));
-    // Per-μ leave-one-subject-out with bounded refits per fold; pooled it agrees with the
-    // pipeline's (which keeps α₁ on its bound in every fold) to a few per cent.
+    // Per-μ leave-one-subject-out: every fold re-solves the bounded problem; the model is
+    // separable, so a fold is each μ's clamped line on the other subjects' points.
     let d = |n: &str| rec.derived.iter().find(|d| d.name == n).map(|d| d.value);
-    for i in 1..=4 {
-        let v = d(&format!(
-            "mu{i}: leave-one-subject-out rmse (bounded refits)"
-        ))
-        .unwrap();
-        assert!(v > d(&format!("mu{i}: rmse")).unwrap());
+    let (mut all_sq, mut all_n) = (0.0, 0usize);
+    for i in 0..4 {
+        let pts: Vec<(String, f64, f64)> = bundled_tables()
+            .iter()
+            .flat_map(|p| subject_points_from_csv(p, i))
+            .collect();
+        let subjects: std::collections::BTreeSet<&str> = pts.iter().map(|p| p.0.as_str()).collect();
+        let s = if i == 0 { -1.0 } else { 1.0 };
+        let mut sq = 0.0;
+        for held in &subjects {
+            let train: Vec<(f64, f64)> = pts
+                .iter()
+                .filter(|p| p.0 != *held)
+                .map(|p| (p.1, p.2))
+                .collect();
+            let (a, m) = separable_line(&train, i, sl, rel.bounds(i));
+            sq += pts
+                .iter()
+                .filter(|p| p.0 == *held)
+                .map(|p| (p.2 - (s * a * (p.1 - sl) + m)).powi(2))
+                .sum::<f64>();
+        }
+        let want = (sq / pts.len() as f64).sqrt();
+        let got = d(&format!("mu{}: leave-one-subject-out rmse", i + 1)).unwrap();
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "mu{}: {got} vs {want}",
+            i + 1
+        );
+        all_sq += sq;
+        all_n += pts.len();
     }
-    let pooled = d("all outputs: leave-one-subject-out rmse (bounded refits)").unwrap();
+    let pooled = (all_sq / all_n as f64).sqrt();
     let loso = rec.loso_rmse.unwrap();
-    assert!((pooled / loso - 1.0).abs() < 0.05, "{pooled} vs {loso}");
+    assert!((pooled - loso).abs() < 1e-9 * loso, "{pooled} vs {loso}");
+    let b = rec.bounded.as_ref().unwrap();
+    assert!(b.solves > 1 && b.converged == b.solves);
 }
 
 /// A trials table of `subjects × steps` walking steps with μ = the μ-functions at `alpha`, `mu`

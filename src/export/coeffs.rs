@@ -201,6 +201,12 @@ pub struct BreakpointRecord {
     /// Why not, when not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub irregular_because: Option<String>,
+    /// The design effect the likelihood ratio was divided by (clustered inference).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub design_effect: Option<f64>,
+    /// The uncorrected F set's pieces (rows treated as independent), for comparison.
+    #[serde(default, skip_serializing_if = "Vec::is_empty", with = "piece_list")]
+    pub pieces_iid: Vec<[Option<f64>; 2]>,
 }
 
 /// Serde for a list of `[lo, hi]` pieces as `{ lo, hi }` tables (like `ci95`).

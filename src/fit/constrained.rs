@@ -2,30 +2,34 @@
 //! ([`Relation::bounds`]) or several outputs per row ([`Relation::outputs`]) — today `kb-mu`.
 //!
 //! # Bounds
-//! The bounded least-squares problem is solved with argmin's bounded trust region
-//! ([`super::nonlinear::nls`]) over the free parameters. A parameter that ends on a bound, and
-//! whose residual-sum-of-squares gradient there points out of the allowed range (the KKT
-//! condition, so that a solution merely *near* a bound is not mistaken for one *on* it), is then
-//! held at the bound and the others refitted by the pipeline's QR: for a model linear in its
-//! parameters that reproduces the bounded optimum exactly, and the record says "bound active".
-//! Its standard error is undefined (none is reported); the others' are conditional on it.
-//! Leave-one-subject-out and bootstrap refits keep an active parameter at its bound.
-//! Per-subject effects are not part of the bounded problem (no bounded relation has one).
+//! A relation linear in its coefficients with bounds on some of them is a convex quadratic
+//! programme, solved exactly from the normal equations by the active-set method of
+//! [`super::bounded`] — for the fit, in every leave-one-subject-out fold and in every bootstrap
+//! replicate (each from summed per-subject normal equations). Every solve's KKT conditions are
+//! checked, and the record counts the solves and how many passed ([`BoxStats`]). A coefficient
+//! on an active bound in the fit is then held at the bound and the others refitted: for a model
+//! linear in its parameters that is the bounded optimum, and the record says "bound active". Its
+//! standard error is undefined (none is reported); the others' are conditional on it. Folds and
+//! replicates re-solve the bounded problem over every coefficient the data could identify, so a
+//! bound active on all data may be inactive in a fold. Bounds apply to coefficients of the raw
+//! basis (the default [`Relation::basis`]); per-subject effects are not bounded.
 //!
 //! # Several outputs
 //! Each row gives one observation per output (a μ-function of `kb-mu`). The pooled r² centres
 //! every output on its own mean, 1 − RSS/Σₖ Σ_{i∈k} (yᵢ − ȳₖ)², so that the different levels of
 //! the outputs (a knee angle near 0, a foot angle near 70°) do not count as explained variance;
 //! per output, n, r² (centred on its mean), rmse, leave-one-out rmse, leave-one-subject-out
-//! rmse and the published coefficients' r² and rmse are reported as derived quantities. The
-//! per-output leave-one-subject-out errors re-solve the bounded problem in every fold (argmin),
-//! so they also count folds where a bound that is active on all data would not be; the
-//! record's pooled `loso_rmse` (generic pipeline) keeps it on the bound.
-use super::nonlinear::{nls, Model, NlsOptions, Rows};
+//! rmse and the published coefficients' r² and rmse are reported as derived quantities. Each
+//! output has its own residual variance: clustered standard errors (the default) are sandwich
+//! estimates and need no common variance, and `--se iid` uses one variance per output
+//! ([`super::design::Covariance`]).
+use super::bounded::BoxSolution;
+use super::design::Layout;
 use super::pipeline::Prepared;
 use super::FitError;
-use crate::export::coeffs::DerivedRecord;
-use crate::relations::{Relation, MAX_INPUTS};
+use crate::export::coeffs::{BoundedRecord, DerivedRecord};
+use crate::relations::{ParamKind, Relation};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// A parameter held on its bound.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,119 +53,110 @@ impl ActiveBound {
     }
 }
 
-struct Adapter<'a> {
-    rel: &'a dyn Relation,
-    p: &'a [f64],
-    idx: &'a [usize],
+/// The bounds of a layout's global columns, and which parameter each bounded column is.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ColumnBounds {
+    /// Lower bounds per global column (−∞ when unbounded).
+    pub lo: Vec<f64>,
+    /// Upper bounds per global column (+∞ when unbounded).
+    pub hi: Vec<f64>,
+    /// The parameter index of each global column (`None` for a column that is not one
+    /// parameter alone).
+    pub param: Vec<Option<usize>>,
 }
 
-impl Adapter<'_> {
-    fn full(&self, theta: &[f64]) -> Vec<f64> {
-        let mut q = self.p.to_vec();
-        for (j, &i) in self.idx.iter().enumerate() {
-            q[i] = theta[j];
-        }
-        q
-    }
-}
-
-impl Model for Adapter<'_> {
-    fn n_params(&self) -> usize {
-        self.idx.len()
-    }
-    fn value(&self, x: &[f64], theta: &[f64]) -> f64 {
-        self.rel.predict_with(&self.full(theta), 0.0, x)
-    }
-    fn gradient(&self, x: &[f64], theta: &[f64], out: &mut [f64]) {
-        let q = self.full(theta);
-        match self.rel.gradient(&q, x) {
-            Some(g) => {
-                for (j, &i) in self.idx.iter().enumerate() {
-                    out[j] = g[i];
-                }
-            }
-            None => {
-                // Central differences (the trait's default, reached through a plain closure).
-                let f = super::nonlinear::FnModel {
-                    n_params: self.idx.len(),
-                    f: |x: &[f64], t: &[f64]| self.rel.predict_with(&self.full(t), 0.0, x),
-                };
-                f.gradient(x, theta, out);
-            }
-        }
-    }
-}
-
-/// Solves the bounded least-squares problem over the `free` parameters (the others at `p`)
-/// with argmin and returns the parameters on an active bound plus a note on the solver run;
-/// empty when no free parameter has a finite bound.
-pub fn active_bounds(
+/// The bounds of the free parameters of `lay` as bounds on its global columns, or `None` when no
+/// free parameter has a finite bound. An error when a bounded parameter is not a column of the
+/// basis by itself (bounds need the raw basis) or sits beside a per-subject effect.
+pub fn column_bounds(
     rel: &dyn Relation,
-    prep: &Prepared,
-    free: &[bool],
+    lay: &Layout,
     p: &[f64],
-    weighted: bool,
-) -> Result<(Vec<ActiveBound>, Option<String>), FitError> {
-    let idx: Vec<usize> = (0..p.len()).filter(|&i| free[i]).collect();
-    let ranges: Vec<(f64, f64)> = idx.iter().map(|&i| rel.bounds(i)).collect();
-    if ranges
-        .iter()
-        .all(|b| b.0 == f64::NEG_INFINITY && b.1 == f64::INFINITY)
-    {
-        return Ok((Vec::new(), None));
-    }
-    let rows: Vec<f64> = prep.obs.iter().flat_map(|o| o.x).collect();
-    let y: Vec<f64> = prep.obs.iter().map(|o| o.y).collect();
-    let start: Vec<f64> = idx
-        .iter()
-        .zip(&ranges)
-        .map(|(&i, b)| p[i].clamp(b.0, b.1))
+) -> Result<Option<ColumnBounds>, FitError> {
+    let specs = rel.parameters();
+    let bounded: Vec<usize> = (0..specs.len())
+        .filter(|&i| lay.free[i] && specs[i].kind == ParamKind::Linear)
+        .filter(|&i| {
+            let (lo, hi) = rel.bounds(i);
+            lo > f64::NEG_INFINITY || hi < f64::INFINITY
+        })
         .collect();
-    let model = Adapter { rel, p, idx: &idx };
-    let opts = NlsOptions {
-        name: rel.id().to_string(),
-        bounds: Some(ranges.clone()),
-        weights: weighted.then(|| prep.weights.clone()),
-        ..NlsOptions::default()
+    if bounded.is_empty() {
+        return Ok(None);
+    }
+    let bad = |why: &str| FitError::InvalidInput {
+        relation: rel.id().to_string(),
+        message: format!("bounded coefficients: {why}"),
     };
-    let r = nls(&model, Rows::new(&rows, MAX_INPUTS)?, &y, &start, &opts)?;
-    let mut out = Vec::new();
-    let mut g = vec![0.0; idx.len()];
-    for (j, &i) in idx.iter().enumerate() {
-        if !r.active_bounds[j] {
+    if lay.subj_col.is_some() {
+        return Err(bad("not supported beside a per-subject effect"));
+    }
+    let m = lay.m();
+    let lm = rel.basis_to_params(p, &lay.free);
+    let mut out = ColumnBounds {
+        lo: vec![f64::NEG_INFINITY; m],
+        hi: vec![f64::INFINITY; m],
+        param: vec![None; m],
+    };
+    let mut row = 0;
+    for (i, s) in specs.iter().enumerate() {
+        if s.kind != ParamKind::Linear {
             continue;
         }
-        let (lo, hi) = ranges[j];
-        let on_lo = (r.theta[j] - lo).abs() <= (r.theta[j] - hi).abs();
-        // KKT: Σ w·e·∂f/∂θⱼ is −½ ∂RSS/∂θⱼ; on the lower bound the fit must want to go lower.
-        let mut push = 0.0;
-        for (k, o) in prep.obs.iter().enumerate() {
-            model.gradient(&o.x, &r.theta, &mut g);
-            push += prep.weights[k] * r.residuals[k] * g[j];
+        let r = lm.map.row(row);
+        let nz: Vec<usize> = (0..m).filter(|&c| r[c] != 0.0).collect();
+        if lay.free[i] && nz.len() == 1 && r[nz[0]] == 1.0 && lm.shift[row] == 0.0 {
+            out.param[nz[0]] = Some(i);
         }
-        let wants_out = if on_lo { push < 0.0 } else { push > 0.0 };
-        if wants_out {
-            out.push(ActiveBound {
-                index: i,
-                value: if on_lo { lo } else { hi },
-                range: (lo, hi),
-            });
+        if bounded.contains(&i) {
+            let Some(c) = out.param.iter().position(|&q| q == Some(i)) else {
+                return Err(bad(&format!(
+                    "{} is not a column of the basis by itself (bounds need the raw basis)",
+                    s.name
+                )));
+            };
+            let (lo, hi) = rel.bounds(i);
+            out.lo[c] = lo;
+            out.hi[c] = hi;
+        }
+        row += 1;
+    }
+    Ok(Some(out))
+}
+
+/// Counts of bounded solves and their KKT checks (shared by parallel folds and replicates).
+#[derive(Debug, Default)]
+pub struct BoxStats {
+    solves: AtomicUsize,
+    converged: AtomicUsize,
+    max_iterations: AtomicUsize,
+}
+
+impl BoxStats {
+    /// Records one solve.
+    pub fn record(&self, s: &BoxSolution) {
+        self.solves.fetch_add(1, Ordering::Relaxed);
+        if s.converged {
+            self.converged.fetch_add(1, Ordering::Relaxed);
+        }
+        self.max_iterations
+            .fetch_max(s.iterations, Ordering::Relaxed);
+    }
+    /// Records a solve that failed (a singular fold or replicate).
+    pub fn record_failure(&self) {
+        self.solves.fetch_add(1, Ordering::Relaxed);
+    }
+    /// The record.
+    pub fn to_record(&self) -> BoundedRecord {
+        BoundedRecord {
+            solver: "box-constrained least squares on the normal equations, primal active set \
+                     (Lawson & Hanson 1974); converged = KKT conditions verified at the solution"
+                .into(),
+            solves: self.solves.load(Ordering::Relaxed),
+            converged: self.converged.load(Ordering::Relaxed),
+            max_iterations: self.max_iterations.load(Ordering::Relaxed),
         }
     }
-    // On a bound the bounds transform flattens the cost, so the trust region often stops on its
-    // iteration budget there; the KKT test above and the QR refit make the result exact anyway.
-    let note = format!(
-        "bounds enforced by argmin's bounded trust region ({} iterations; {}); parameters on \
-         an active bound (checked by the KKT condition) are held there and the rest refitted by \
-         QR, which is the bounded optimum of a model linear in its parameters",
-        r.iterations,
-        if r.converged {
-            "converged".to_string()
-        } else {
-            format!("stopped: {}", r.termination)
-        }
-    );
-    Ok((out, Some(note)))
 }
 
 /// Statistics of a relation with several outputs.
@@ -192,71 +187,18 @@ fn within_ss(rel: &dyn Relation, prep: &Prepared, w: &[f64], k: usize) -> (usize
     (rows.len(), tss)
 }
 
-/// Leave-one-subject-out squared prediction errors per observation, the bounded problem
-/// re-solved by argmin on the other subjects in every fold over the parameters
-/// [`Relation::plan`] leaves free (so a bound active on all data may be inactive in a fold);
-/// NaN where a fold failed or with fewer than 3 subjects.
-fn loso_bounded(rel: &dyn Relation, prep: &Prepared, values: &[f64], weighted: bool) -> Vec<f64> {
-    let n = prep.obs.len();
-    let mut sq = vec![f64::NAN; n];
-    if prep.subjects.len() < 3 {
-        return sq;
-    }
-    let idx: Vec<usize> = rel
-        .plan(&prep.obs)
-        .held
-        .iter()
-        .enumerate()
-        .filter(|(_, h)| h.is_none())
-        .map(|(i, _)| i)
-        .collect();
-    let ranges: Vec<(f64, f64)> = idx.iter().map(|&i| rel.bounds(i)).collect();
-    let start: Vec<f64> = idx
-        .iter()
-        .zip(&ranges)
-        .map(|(&i, b)| values[i].clamp(b.0, b.1))
-        .collect();
-    let model = Adapter {
-        rel,
-        p: values,
-        idx: &idx,
-    };
-    for s in 0..prep.subjects.len() {
-        let train: Vec<usize> = (0..n).filter(|&i| prep.subject[i] != s).collect();
-        let rows: Vec<f64> = train.iter().flat_map(|&i| prep.obs[i].x).collect();
-        let y: Vec<f64> = train.iter().map(|&i| prep.obs[i].y).collect();
-        let opts = NlsOptions {
-            name: rel.id().to_string(),
-            bounds: Some(ranges.clone()),
-            weights: weighted.then(|| train.iter().map(|&i| prep.weights[i]).collect()),
-            ..NlsOptions::default()
-        };
-        let Ok(rows) = Rows::new(&rows, MAX_INPUTS) else {
-            continue;
-        };
-        if let Ok(r) = nls(&model, rows, &y, &start, &opts) {
-            let q = model.full(&r.theta);
-            for i in (0..n).filter(|&i| prep.subject[i] == s) {
-                let o = &prep.obs[i];
-                sq[i] = (o.y - rel.predict_with(&q, 0.0, &o.x)).powi(2);
-            }
-        }
-    }
-    sq
-}
-
 /// Pooled and per-output statistics from the residuals of the refit (`residuals`, with their
-/// `leverage`, at coefficients `values`) and of the published coefficients
-/// (`published_residuals`). `df` is the residual degrees of freedom of the fit. `None` for
-/// single-output relations.
+/// `leverage`) and of the published coefficients (`published_residuals`); `loso_sq` holds each
+/// row's leave-one-subject-out squared prediction error (NaN where its fold failed or there is
+/// none). `df` is the residual degrees of freedom of the fit. `None` for single-output relations.
 #[allow(clippy::too_many_arguments)]
 pub fn output_stats(
     rel: &dyn Relation,
     prep: &Prepared,
-    values: &[f64],
     residuals: &[f64],
     leverage: &[f64],
     published_residuals: &[f64],
+    loso_sq: &[f64],
     weighted: bool,
     df: f64,
 ) -> Option<OutputStats> {
@@ -265,11 +207,10 @@ pub fn output_stats(
         return None;
     }
     let n = prep.obs.len();
-    let loso = loso_bounded(rel, prep, values, weighted);
     let loso_rmse = |rows: &[usize]| {
         let v: Vec<f64> = rows
             .iter()
-            .map(|&i| loso[i])
+            .filter_map(|&i| loso_sq.get(i).copied())
             .filter(|v| v.is_finite())
             .collect();
         if v.len() == rows.len() && !v.is_empty() {
@@ -328,24 +269,8 @@ pub fn output_stats(
         derived.push(rec("leave-one-out rmse", unit, loo, prmse));
         let ls = loso_rmse(&rows);
         if ls.is_finite() {
-            derived.push(rec(
-                "leave-one-subject-out rmse (bounded refits)",
-                unit,
-                ls,
-                prmse,
-            ));
+            derived.push(rec("leave-one-subject-out rmse", unit, ls, prmse));
         }
-    }
-    let all: Vec<usize> = (0..n).collect();
-    let ls = loso_rmse(&all);
-    if ls.is_finite() {
-        let prmse = (published_residuals.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
-        derived.push(DerivedRecord {
-            name: "all outputs: leave-one-subject-out rmse (bounded refits)".into(),
-            unit: unit.to_string(),
-            value: ls,
-            published: prmse,
-        });
     }
     let r2 = 1.0 - rss / tss;
     Some(OutputStats {

@@ -259,6 +259,22 @@ impl Totals {
         self.rho += x.rho;
         self.count += x.count;
     }
+    /// The bounded fit of these sums (no per-subject column): relation-basis coefficients,
+    /// weighted RSS and the solver's outcome, or `None` when singular.
+    pub fn solve_box(
+        &self,
+        lay: &Layout,
+        lo: &[f64],
+        hi: &[f64],
+    ) -> Option<(DVector<f64>, f64, super::bounded::BoxSolution)> {
+        let m = self.m;
+        let a = DMatrix::from_row_slice(m, m, &self.s);
+        let c = DVector::from_column_slice(&self.r);
+        let sol = super::bounded::solve_box(&a, &c, lo, hi)?;
+        let b = &sol.beta;
+        let rss = (self.yy - 2.0 * c.dot(b) + b.dot(&(&a * b))).max(0.0);
+        Some((lay.basis_coef(b.as_slice(), 0.0), rss, sol))
+    }
     /// The fit of these sums: relation-basis coefficients (the per-subject column set to the
     /// subjects' mean slope) and the weighted RSS, or `None` when singular.
     pub fn solve(&self, lay: &Layout) -> Option<(DVector<f64>, f64)> {

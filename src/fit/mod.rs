@@ -7,6 +7,7 @@
 //! - [`nonlinear`]: nonlinear least squares through argmin's trust-region solver
 //!   ([`nonlinear::nls`]) for any [`nonlinear::Model`], and a bounded 1-D minimiser
 //!   ([`nonlinear::minimize_1d`]) for profiling breakpoints;
+//! - [`bounded`]: box-constrained linear least squares, exact (active set, KKT-checked);
 //! - [`design`]: the linear part at fixed breakpoints from per-subject sufficient statistics
 //!   (per-subject effects absorbed), the normal-equation solve, covariances;
 //! - [`inference`]: iid, cluster-robust CR1 and CR2 (Bell–McCaffrey) standard errors;
@@ -15,6 +16,7 @@
 //! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
 use thiserror::Error;
 
+pub mod bounded;
 pub mod constrained;
 pub mod design;
 pub mod inference;

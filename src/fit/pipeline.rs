@@ -42,6 +42,7 @@
 //!    with level 0), the published coefficients' r² and rmse on the same rows, t-tests against
 //!    the published values (where the paper gives one), optional Huber IRLS and weighted fits and
 //!    a seeded bootstrap by subject.
+use super::constrained::{column_bounds, ActiveBound, BoxStats, ColumnBounds};
 use super::design::{augment, Covariance, DesignFit, Layout, SubjectSums, Totals, MAX_BASIS};
 use super::inference::{SeMethod, CR2_RECOMMENDED_BELOW};
 use super::ols::{huber_irls, LinearProblem};
@@ -300,6 +301,7 @@ fn loso_from_subject_sums(
     lay: &Layout,
     p: &[f64],
     prep: &Prepared,
+    bounds: Option<(&ColumnBounds, &BoxStats)>,
 ) -> Vec<Option<Vec<f64>>> {
     let n_subj = prep.subjects.len();
     let m = lay.m();
@@ -333,7 +335,7 @@ fn loso_from_subject_sums(
         .map(|s| {
             let mut t = prefix[s].clone();
             t.add_totals(&suffix[s + 1]);
-            let (coef, _) = t.solve(lay)?;
+            let coef = solve_totals(&t, lay, bounds)?;
             let q = lay.params(rel, p, &coef);
             Some(
                 rows_of[s]
@@ -345,6 +347,42 @@ fn loso_from_subject_sums(
                     .collect(),
             )
         })
+        .collect()
+}
+
+/// The basis coefficients of some subjects' sums, by the bounded solver when there are bounds
+/// (recording the solve), else by the normal equations.
+fn solve_totals(
+    t: &Totals,
+    lay: &Layout,
+    bounds: Option<(&ColumnBounds, &BoxStats)>,
+) -> Option<DVector<f64>> {
+    match bounds {
+        None => t.solve(lay).map(|r| r.0),
+        Some((cb, stats)) => match t.solve_box(lay, &cb.lo, &cb.hi) {
+            Some((coef, _, sol)) => {
+                stats.record(&sol);
+                Some(coef)
+            }
+            None => {
+                stats.record_failure();
+                None
+            }
+        },
+    }
+}
+
+/// Every subject's [`SubjectSums`] at `p`, or `None` when a subject's own column is all zeros.
+fn all_subject_sums(
+    rel: &dyn Relation,
+    lay: &Layout,
+    p: &[f64],
+    prep: &Prepared,
+) -> Option<Vec<SubjectSums>> {
+    let n_subj = prep.subjects.len();
+    super::design::subject_normal_equations(rel, lay, p, prep, None, None, n_subj)
+        .iter()
+        .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
         .collect()
 }
 
@@ -430,6 +468,18 @@ impl FitOutcome {
         let var = ell.dot(&(&b.cov.v * &ell)).max(0.0);
         let q = t_quantile(0.5 + 0.5 * CONFIDENCE, b.cov.df(&ell));
         (m, m - q * var.sqrt(), m + q * var.sqrt())
+    }
+}
+
+/// Rao & Scott's mean design effect `tr(V_iid⁻¹ V)/p` (NaN when `V_iid` is singular).
+fn design_effect(v_iid: &DMatrix<f64>, v: &DMatrix<f64>) -> f64 {
+    let p = v.nrows();
+    if p == 0 {
+        return 1.0;
+    }
+    match v_iid.clone().cholesky() {
+        Some(c) => c.solve(v).trace() / p as f64,
+        None => f64::NAN,
     }
 }
 
@@ -608,16 +658,47 @@ pub fn fit_relation(
             )?;
         }
     }
-    // Bounded parameters (Relation::bounds): argmin's bounded fit decides which sit on a bound.
+    // Bounded parameters (Relation::bounds): the exact bounded least-squares solution decides
+    // which sit on a bound (module constrained).
     let mut bound_flag: Vec<Option<String>> = vec![None; specs.len()];
-    let (hits, bound_note) =
-        super::constrained::active_bounds(rel, &prep, &free, &p, opts.weights.is_some())?;
-    notes.extend(bound_note);
-    for b in hits {
-        free[b.index] = false;
-        p[b.index] = b.value;
-        held_reason[b.index] = Some(b.describe(specs[b.index].name));
-        bound_flag[b.index] = Some("bound active".into());
+    let col_bounds = column_bounds(rel, &lay, &p)?;
+    let box_stats = BoxStats::default();
+    let (lay_pre, p_pre) = (lay.clone(), p.clone());
+    if let Some(cb) = &col_bounds {
+        let sums = all_subject_sums(rel, &lay, &p, &prep).ok_or_else(|| FitError::Singular {
+            relation: id.clone(),
+            message: "a subject's own column is all zeros".into(),
+        })?;
+        let mut t = Totals::zeros(lay.m());
+        sums.iter().for_each(|s| t.add(s, 1.0));
+        let (_, _, sol) = t
+            .solve_box(&lay, &cb.lo, &cb.hi)
+            .ok_or_else(|| FitError::Singular {
+                relation: id.clone(),
+                message: "the bounded least-squares problem is singular".into(),
+            })?;
+        box_stats.record(&sol);
+        for (c, &side) in sol.active.iter().enumerate() {
+            let Some(i) = cb.param[c].filter(|_| side != 0) else {
+                continue;
+            };
+            let b = ActiveBound {
+                index: i,
+                value: if side < 0 { cb.lo[c] } else { cb.hi[c] },
+                range: rel.bounds(i),
+            };
+            free[i] = false;
+            p[i] = b.value;
+            held_reason[i] = Some(b.describe(specs[i].name));
+            bound_flag[i] = Some("bound active".into());
+        }
+        notes.push(
+            "bounds enforced exactly: box-constrained least squares on the normal equations by \
+             an active-set method (KKT conditions checked); coefficients on an active bound are \
+             held there and the rest refitted; leave-one-subject-out folds and bootstrap \
+             replicates re-solve the bounded problem (see bounded for every solve's convergence)"
+                .into(),
+        );
     }
     lay = Layout::new(rel, free.clone(), n_subj);
     let bps: Vec<usize> = (0..specs.len())
@@ -687,34 +768,44 @@ pub fn fit_relation(
             message: "the covariance of the coefficients is singular".into(),
         })?;
     let tq_iid = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
-    let mut bp_records = Vec::new();
-    let mut bp_hull: BTreeMap<usize, [Option<f64>; 2]> = BTreeMap::new();
-    let mut all_regular = n_bp > 0;
-    for &i in &bps {
-        let pr = Profiler {
-            rel,
-            lay: &lay,
-            src,
-        };
-        let rmin = pr.rss(&p);
-        let thr = rmin * (1.0 + tq_iid * tq_iid / df);
-        let set = confidence_set(&pr, &p, i, &plan.search, thr);
-        let (rec, hull) = set.record(specs[i].name);
-        all_regular &= rec.regular;
-        bp_hull.insert(i, hull);
-        bp_records.push(rec);
-    }
-    let cov_f = if all_regular {
+    // Breakpoint sets: the profile likelihood-ratio (F) test. With clustered inference the
+    // likelihood ratio is divided by a design effect (Rao & Scott 1984) and compared with
+    // F(1, G − 1): the breakpoint's own, V_clustered/V_iid from the Gauss–Newton covariances,
+    // when its profile is regular; otherwise Rao & Scott's first-order δ̄ = tr(V_iid⁻¹ V)/p of
+    // the linear coefficients. With iid inference this is the plain F-test.
+    let pr = Profiler {
+        rel,
+        lay: &lay,
+        src,
+    };
+    let rmin = if n_bp > 0 { pr.rss(&p) } else { rss };
+    let sigma2_min = rmin / df;
+    let plain: Vec<_> = bps
+        .iter()
+        .map(|&i| {
+            let set = confidence_set(
+                &pr,
+                &p,
+                i,
+                &plan.search,
+                rmin + sigma2_min * tq_iid * tq_iid,
+            );
+            set.record(specs[i].name)
+        })
+        .collect();
+    // Gauss–Newton covariances with the breakpoints free (all plain profiles regular).
+    let aug_covs = if n_bp > 0 && plain.iter().all(|(r, _)| r.regular) {
         let coef = fit.coef.clone();
         let sc = lay.subj_col;
-        let subj_coef = |s: usize| {
-            let mut c = coef.clone();
-            if let Some(sc) = sc {
-                c[sc] = fit.gammas[s];
-            }
-            c
-        };
-        let subj_coefs: Vec<DVector<f64>> = (0..n_subj).map(subj_coef).collect();
+        let subj_coefs: Vec<DVector<f64>> = (0..n_subj)
+            .map(|s| {
+                let mut c = coef.clone();
+                if let Some(sc) = sc {
+                    c[sc] = fit.gammas[s];
+                }
+                c
+            })
+            .collect();
         let mean_at = |q: &[f64], c: &DVector<f64>, x: &[f64]| {
             let mut phi = [0.0; MAX_BASIS];
             let off = rel.basis(q, &lay.free, x, &mut phi[..lay.nb]);
@@ -732,7 +823,67 @@ pub fn fit_relation(
             }
         };
         let aug = augment(rel, &fit, &p, &prep, n_bp, &jac);
-        Covariance::new(method, &aug.a, &aug.clusters, &fit, &aug.d, n, k, k)
+        let cv = |m: SeMethod| Covariance::new(m, &aug.a, &aug.clusters, &fit, &aug.d, n, k, k);
+        match (cv(method), cv(SeMethod::Iid)) {
+            (Some(c), Some(i)) => Some((c, i)),
+            _ => None,
+        }
+    } else {
+        None
+    };
+    let delta_bar = match method {
+        SeMethod::Iid => 1.0,
+        _ => Covariance::new(
+            SeMethod::Iid,
+            &fit.a,
+            &fit.clusters,
+            &fit,
+            &fe_d,
+            n,
+            k,
+            k - n_bp,
+        )
+        .map_or(f64::NAN, |ci| design_effect(&ci.v, &cov_c.v)),
+    };
+    let tq_cl = t_quantile(0.5 + 0.5 * CONFIDENCE, n_subj as f64 - 1.0);
+    let mut bp_records = Vec::new();
+    let mut bp_hull: BTreeMap<usize, [Option<f64>; 2]> = BTreeMap::new();
+    let mut all_regular = n_bp > 0;
+    for (b, (&i, (plain_rec, plain_hull))) in bps.iter().zip(plain).enumerate() {
+        let (rec, hull) = if method == SeMethod::Iid {
+            (plain_rec, plain_hull)
+        } else {
+            let m = lay.m();
+            let (delta, whose) = match &aug_covs {
+                Some((c, ci)) => (
+                    c.v[(m + b, m + b)] / ci.v[(m + b, m + b)],
+                    format!("{}'s own, V_clustered/V_iid", specs[i].name),
+                ),
+                None => (
+                    delta_bar,
+                    "first-order δ̄ of the linear coefficients".to_string(),
+                ),
+            };
+            let thr = rmin + sigma2_min * delta * tq_cl * tq_cl;
+            let (mut rec, hull) =
+                confidence_set(&pr, &p, i, &plan.search, thr).record(specs[i].name);
+            rec.pieces_iid = plain_rec.pieces;
+            rec.design_effect = opt(delta);
+            rec.method = format!(
+                "{}; the likelihood ratio divided by the design effect of the clustering (Rao & \
+                 Scott 1984; {whose}: {delta:.3}) against F(1, {}) (pieces_iid: the uncorrected \
+                 F set, rows treated as independent)",
+                rec.method,
+                n_subj - 1
+            );
+            (rec, hull)
+        };
+        all_regular &= rec.regular;
+        bp_hull.insert(i, hull);
+        bp_records.push(rec);
+    }
+    let cov_f = if all_regular {
+        aug_covs.map(|(c, _)| c)
     } else {
         None
     };
@@ -971,20 +1122,24 @@ pub fn fit_relation(
         ));
     }
 
-    // Leave-one-subject-out.
+    // Leave-one-subject-out: each row's squared prediction error from its subject's fold.
     let plan_fixed = rel.plan(&[]) == plan;
+    let linear_folds = n_bp == 0 && (plan_fixed || sorted.is_some());
+    let fold_bounds = col_bounds.as_ref().map(|cb| (cb, &box_stats));
+    let mut rows_of = vec![Vec::new(); n_subj];
+    for (i, &s) in prep.subject.iter().enumerate() {
+        rows_of[s].push(i);
+    }
+    let mut loso_sq = vec![f64::NAN; n];
     let (loso_rmse, loso_note) = if n_subj >= 3 {
         let sq_err = |q: &[f64], i: usize| {
             let o = &prep.obs[i];
             (o.y - rel.predict_with(q, 0.0, &o.x)).powi(2)
         };
-        let res: Vec<Vec<f64>> = match &sorted {
+        // Per subject (in subject order): its rows' errors, or None when the fold failed.
+        let res: Vec<Option<Vec<f64>>> = match &sorted {
             // Folds are subject multisets: no pass over the training rows.
             Some(sr) if n_bp > 0 => {
-                let mut rows_of = vec![Vec::new(); n_subj];
-                for (i, &s) in prep.subject.iter().enumerate() {
-                    rows_of[s].push(i);
-                }
                 use rayon::prelude::*;
                 (0..n_subj)
                     .into_par_iter()
@@ -993,34 +1148,41 @@ pub fn fit_relation(
                         let q = refit(rel, &free, &p, fold)?;
                         Some(rows_of[s].iter().map(|&i| sq_err(&q, i)).collect())
                     })
-                    .collect::<Vec<Option<Vec<f64>>>>()
-                    .into_iter()
-                    .flatten()
                     .collect()
             }
             // Nothing but linear coefficients to refit, and a plan that does not depend on the
-            // rows: a fold's sums are the other subjects' sums, all from one pass.
-            _ if n_bp == 0 && (plan_fixed || sorted.is_some()) => {
-                loso_from_subject_sums(rel, &lay, &p, &prep)
-                    .into_iter()
-                    .flatten()
-                    .collect()
-            }
+            // rows: a fold's sums are the other subjects' sums, all from one pass (bounded
+            // problems re-solved over every coefficient the data identify).
+            _ if linear_folds => match fold_bounds {
+                Some(_) => loso_from_subject_sums(rel, &lay_pre, &p_pre, &prep, fold_bounds),
+                None => loso_from_subject_sums(rel, &lay, &p, &prep, None),
+            },
             _ => leave_one_group_out(&prep.subject, |train, test| {
-                let q = refit(rel, &free, &p, Subset::Rows(&prep, train))?;
-                Some(test.iter().map(|&i| sq_err(&q, i)).collect::<Vec<f64>>())
+                Some(
+                    refit(rel, &free, &p, Subset::Rows(&prep, train))
+                        .map(|q| test.iter().map(|&i| sq_err(&q, i)).collect::<Vec<f64>>()),
+                )
             }),
         };
-        let folds = res.len();
-        let sq: Vec<f64> = res.into_iter().flatten().collect();
-        if folds == n_subj && !sq.is_empty() {
+        let mut folds = 0;
+        for (s, r) in res.into_iter().enumerate() {
+            if let Some(v) = r {
+                folds += 1;
+                for (&i, e) in rows_of[s].iter().zip(v) {
+                    loso_sq[i] = e;
+                }
+            }
+        }
+        if folds == n_subj && loso_sq.iter().all(|v| v.is_finite()) {
             (
-                Some((sq.iter().sum::<f64>() / sq.len() as f64).sqrt()),
+                Some((loso_sq.iter().sum::<f64>() / n as f64).sqrt()),
                 format!(
                     "{n_subj} folds; each subject predicted (level 0) from a full refit{}, on \
                      the others",
                     if n_bp > 0 {
                         ", breakpoints included"
+                    } else if col_bounds.is_some() {
+                        ", the bounded problem re-solved"
                     } else {
                         ""
                     }
@@ -1060,10 +1222,10 @@ pub fn fit_relation(
     let multi = super::constrained::output_stats(
         rel,
         &prep,
-        &values,
         &residuals,
         &fit.leverage,
         &pub_res,
+        &loso_sq,
         weighted,
         df,
     );
@@ -1091,27 +1253,31 @@ pub fn fit_relation(
     // Bootstrap by subject.
     let bootstrap = if opts.bootstrap > 0 {
         let groups = prep.subject.clone();
-        let idx_free: Vec<usize> = (0..specs.len()).filter(|&i| free[i]).collect();
-        let summary = if n_bp == 0 && (plan_fixed || sorted.is_some()) {
-            // Replicates are sums of per-subject records: no pass over the rows.
-            let nes =
-                super::design::subject_normal_equations(rel, &lay, &p, &prep, None, None, n_subj);
-            let sums: Option<Vec<SubjectSums>> = nes
-                .iter()
-                .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
-                .collect();
-            let sums = sums.ok_or_else(|| FitError::Singular {
+        // Bounded problems report every coefficient the data identify (a bound active on all
+        // data may be inactive in a replicate).
+        let idx_free: Vec<usize> = (0..specs.len())
+            .filter(|&i| free[i] || (fold_bounds.is_some() && lay_pre.free[i]))
+            .collect();
+        let summary = if linear_folds {
+            // Replicates are sums of per-subject records: no pass over the rows (bounded
+            // problems re-solved over every coefficient the data identify).
+            let (bl, bp_) = if fold_bounds.is_some() {
+                (&lay_pre, &p_pre)
+            } else {
+                (&lay, &p)
+            };
+            let sums = all_subject_sums(rel, bl, bp_, &prep).ok_or_else(|| FitError::Singular {
                 relation: id.clone(),
                 message: "a subject's own slope column is all zeros".into(),
             })?;
             bootstrap_by_group(&groups, opts.bootstrap, opts.seed, |rows| {
                 let m_list = whole_subjects(&prep, rows)?;
-                let mut t = Totals::zeros(lay.m());
+                let mut t = Totals::zeros(bl.m());
                 for (s, mult) in m_list {
                     t.add(&sums[s], mult);
                 }
-                let (coef, _) = t.solve(&lay)?;
-                let q = lay.params(rel, &p, &coef);
+                let coef = solve_totals(&t, bl, fold_bounds)?;
+                let q = bl.params(rel, bp_, &coef);
                 Some(idx_free.iter().map(|&i| q[i]).collect())
             })
         } else {
@@ -1269,7 +1435,7 @@ pub fn fit_relation(
         outside_range: None,
         inference: Some(inference),
         breakpoints: bp_records,
-        bounded: None,
+        bounded: col_bounds.as_ref().map(|_| box_stats.to_record()),
         data: DataRecord {
             path,
             sha256,

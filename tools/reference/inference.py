@@ -92,34 +92,48 @@ def tflight(df):
     js = list(range(min_distinct, nk - min_distinct + 1))
     r = np.array([rss(j) for j in js])
     n = len(y)
+    G = g.max() + 1
     k = 8  # 7 linear coefficients and k1 (k2 held)
     dfr = n - k
-    fq = scipy.stats.f.ppf(0.95, 1, dfr)
-    thr = r.min() * (1.0 + fq / dfr)
     best = js[int(np.argmin(r))]
-    acc = [j for j, v in zip(js, r) if v <= thr]
-    pieces = []
-    i = 0
-    while i < len(acc):
-        e = i
-        while e + 1 < len(acc) and acc[e + 1] == acc[e] + 1:
-            e += 1
-        a, b = acc[i], acc[e]
-        pieces.append([None if a == js[0] else float(keys[a - 1]),
-                       None if b == js[-1] else float(keys[b])])
-        i = e + 1
+
+    def pieces_of(thr):
+        acc = [j for j, v in zip(js, r) if v <= thr]
+        pieces = []
+        i = 0
+        while i < len(acc):
+            e = i
+            while e + 1 < len(acc) and acc[e + 1] == acc[e] + 1:
+                e += 1
+            a, b = acc[i], acc[e]
+            pieces.append([None if a == js[0] else float(keys[a - 1]),
+                           None if b == js[-1] else float(keys[b])])
+            i = e + 1
+        return len(acc), pieces
+
     # Linear coefficients at the estimate (midpoint of the best gap), CR1 conditional on k1.
     xd, tmat = design(best)
     cl = sm.OLS(y, xd).fit(cov_type="cluster", cov_kwds={"groups": g}, use_t=True)
     raw = tmat @ cl.params
     vraw = tmat @ cl.cov_params() @ tmat.T
+    # The plain F set, and the clustered one: the likelihood ratio divided by Rao & Scott's
+    # first-order design effect tr(V_iid⁻¹ V_CR1)/p of the linear coefficients (V_iid with
+    # σ² = RSS/(n − 8), k1 counted), against F(1, G − 1).
+    sigma2 = r.min() / dfr
+    v_iid = sigma2 * np.linalg.inv(xd.T @ xd)
+    delta = float(np.trace(np.linalg.solve(v_iid, cl.cov_params())) / 7)
+    n_iid, pieces_iid = pieces_of(r.min() + sigma2 * scipy.stats.f.ppf(0.95, 1, dfr))
+    n_acc, pieces = pieces_of(r.min() + sigma2 * delta * scipy.stats.f.ppf(0.95, 1, G - 1))
     return {
         "n": int(n),
         "clusters": int(g.max() + 1),
         "k1": float(0.5 * (keys[best - 1] + keys[best])),
         "k1_admissible": len(js),
-        "k1_accepted": len(acc),
+        "k1_accepted": n_acc,
         "k1_pieces": pieces,
+        "k1_design_effect": delta,
+        "k1_accepted_iid": n_iid,
+        "k1_pieces_iid": pieces_iid,
         "coef": list(raw),
         "se_cr1_conditional": list(np.sqrt(np.diag(vraw))),
     }
@@ -196,6 +210,17 @@ def run_sl_v(df):
         meat += np.outer(pc, pc)
         psib.append(ella @ pc + (gam[c] - gbar) / G)
     va = c1a * meat
+    # v_norm's confidence set: the profile likelihood ratio divided by v_norm's own design
+    # effect V_CR1/V_iid (Gauss–Newton, σ² = RSS/(n − K − 1)) against F(1, G − 1); its ends by
+    # root finding on the profile.
+    sigma2 = float(e @ e) / (n - ka)
+    delta = va[K, K] / (sigma2 * ma[K, K])
+    rmin = float(e @ e)
+    thr = rmin + sigma2 * delta * scipy.stats.f.ppf(0.95, 1, G - 1)
+    inside = [tt for tt, rr in zip(grid, rg) if rr <= thr]
+    f = lambda tt: rss(tt) - thr
+    lo_end = scipy.optimize.brentq(f, inside[0] - (grid[1] - grid[0]), inside[0], xtol=1e-9)
+    hi_end = scipy.optimize.brentq(f, inside[-1], inside[-1] + (grid[1] - grid[0]), xtol=1e-9)
     return {
         "n": int(n),
         "clusters": int(G),
@@ -210,6 +235,66 @@ def run_sl_v(df):
         "se_a_cr1_free": float(math.sqrt(va[0, 0])),
         "se_b_cr1_free": float(math.sqrt(c1a * sum(p * p for p in psib))),
         "se_v_norm_cr1_free": float(math.sqrt(va[K, K])),
+        "v_norm_design_effect": float(delta),
+        "v_norm_set": [float(lo_end), float(hi_end)],
+    }
+
+
+def kb_mu(df):
+    """Ko–Badler μ-lines: per output, μ = sign·α·(x − sl*) + μ*, x = sl·ll*/ll. α1 sits on its
+    bound 0 on these data (its unconstrained slope is negative), so output 1 fits μ1* alone.
+    Standard errors: iid with one residual variance per output (each output's own OLS), and CR1
+    on the stacked outputs clustered by subject (statsmodels)."""
+    sl_star = 0.7071025  # KbMu::published().sl_star(): the bundled prototype's step length
+    ll_star = 0.81  # WINTER_TABLE_LEG_LENGTH
+    d = df[(df.gait == "walk") & (~df.flagged)].dropna(subset=["sl", "ll"])
+    d = d[(d.sl > 0) & (d.ll > 0)]
+    cols = ["knee_hs", "foot_hs", "foot_to", "meta_to"]
+    blocks = []
+    for k, c in enumerate(cols):
+        e = d.dropna(subset=[c])
+        xk = e.sl.values * ll_star / e.ll.values
+        sign = -1.0 if k == 0 else 1.0
+        blocks.append((k, sign * (xk - sl_star), e[c].values, list(e.subject)))
+    # Subjects in order of first appearance over rows, output by output within a row (gaitfit).
+    order = []
+    for _, r in d.iterrows():
+        if any(not np.isnan(r[c]) for c in cols) and r.subject not in order:
+            order.append(r.subject)
+    names = ["alpha2", "alpha3", "alpha4", "mu1_star", "mu2_star", "mu3_star", "mu4_star"]
+    xs, ys, gs = [], [], []
+    se_iid = {}
+    for k, z, y, subj in blocks:
+        if k == 0:
+            xk = np.ones((len(y), 1))
+        else:
+            xk = np.column_stack([z, np.ones(len(y))])
+        o = sm.OLS(y, xk).fit()
+        if k == 0:
+            se_iid["mu1_star"] = float(o.bse[0])
+        else:
+            se_iid[f"alpha{k + 1}"] = float(o.bse[0])
+            se_iid[f"mu{k + 1}_star"] = float(o.bse[1])
+        row = np.zeros((len(y), 7))
+        if k == 0:
+            row[:, 3] = 1.0
+        else:
+            row[:, k - 1] = z
+            row[:, 3 + k] = 1.0
+        xs.append(row)
+        ys.append(y)
+        gs += [order.index(s_) for s_ in subj]
+    x = np.vstack(xs)
+    y = np.concatenate(ys)
+    g = np.array(gs)
+    cl = sm.OLS(y, x).fit(cov_type="cluster", cov_kwds={"groups": g}, use_t=True)
+    return {
+        "n": int(len(y)),
+        "clusters": int(g.max() + 1),
+        "names": names,
+        "coef": dict(zip(names, map(float, cl.params))),
+        "se_cr1": dict(zip(names, map(float, cl.bse))),
+        "se_iid_per_output": se_iid,
     }
 
 
@@ -231,6 +316,7 @@ def main():
     out["walk-sl-sf"] = linear((d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values, g)
     out["run-tflight-sf"] = tflight(df)
     out["run-sl-v"] = run_sl_v(df)
+    out["kb-mu"] = kb_mu(df)
     with open(OUT, "w") as f:
         json.dump(out, f, indent=1)
         f.write("\n")

@@ -937,6 +937,8 @@ impl ConfidenceSet {
                 local_minima: self.local_minima,
                 regular: why.is_none(),
                 irregular_because: why,
+                design_effect: None,
+                pieces_iid: Vec::new(),
             },
             hull,
         )
