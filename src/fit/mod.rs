@@ -24,6 +24,7 @@ pub mod nonlinear;
 pub mod ols;
 pub mod pipeline;
 pub mod prec;
+pub mod record;
 pub mod stats;
 pub mod strd;
 pub mod synthetic;

@@ -47,14 +47,14 @@ use super::design::{augment, Covariance, DesignFit, Layout, SubjectSums, Totals,
 use super::inference::{SeMethod, CR2_RECOMMENDED_BELOW};
 use super::ols::{huber_irls, LinearProblem};
 use super::prec::ILL_CONDITIONED;
+use super::record::{
+    BootstrapRecord, CoefficientRecord, DataFile, DataRecord, DerivedRecord, FitRecord,
+    InferenceRecord, PublishedFit, RangeRecord, RejectionRecord, RobustRecord, TTestRecord,
+};
 use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
 };
 use super::FitError;
-use crate::export::coeffs::{
-    BootstrapRecord, CoefficientRecord, DataFile, DataRecord, DerivedRecord, FitRecord,
-    InferenceRecord, PublishedFit, RangeRecord, RejectionRecord, RobustRecord, TTestRecord,
-};
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Observation, ParamKind, Relation};
 use profile::{

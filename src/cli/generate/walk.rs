@@ -2,8 +2,9 @@
 //! length and/or step frequency.
 use super::common::{freq_arg, length_arg, speed_arg, Common};
 use crate::events::Gait;
-use crate::generator::schedule::{walk_params, Schedule};
+use crate::generator::schedule::Schedule;
 use crate::generator::skeleton::Skeleton;
+use crate::generator::walking::walk_params;
 use crate::generator::walking::{
     generate_walk, high_level, steps_for_duration, ScheduleEntry, WalkOptions, WalkParams,
     WalkRelations, WalkReport, ATTRIBUTES,

@@ -28,10 +28,10 @@
 //!   and its interval ends are data keys (where the partition changes).
 //! - Two breakpoints are profiled by coordinate descent.
 use super::Prepared;
-use crate::export::coeffs::BreakpointRecord;
 use crate::fit::design::{solve_rows, Layout, SubjectSums, Totals};
 use crate::fit::nonlinear::minimize_1d;
 use crate::fit::prec::MIN1D_GRID;
+use crate::fit::record::BreakpointRecord;
 use crate::fit::FitError;
 use crate::relations::{
     FeatureSums, KeyRange, KeyScale, KeySums, Observation, ParamKind, Relation, SortedProfile,

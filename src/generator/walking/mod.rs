@@ -54,6 +54,7 @@ pub mod generate;
 pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
+pub mod schedule;
 pub mod shooting;
 pub mod stance;
 pub mod stop;
@@ -64,6 +65,7 @@ pub mod virtual_leg;
 pub use attributes::{WalkAttributes, ATTRIBUTES};
 pub use generate::{StepReport, WalkOptions, WalkReport};
 pub use high_level::{Locomotion, WalkParams, WalkRelations};
+pub use schedule::{walk_params, WalkSchedule};
 
 use crate::generator::motion::Motion;
 use crate::generator::GenerateError;
