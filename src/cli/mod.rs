@@ -8,6 +8,7 @@ pub mod events;
 pub mod export;
 pub mod fit;
 pub mod generate;
+pub mod inspect;
 pub mod studio;
 
 /// gaitfit: fit the published gait relations of KLAW (1989), RUNNER (1996) and Ko–Badler
@@ -35,6 +36,9 @@ pub enum Command {
     Events(Box<events::Args>),
     /// Generate motion (running, walking, or a generalized measured walk).
     Generate(generate::Args),
+    /// Print what a reader loaded from a file; -o writes its per-frame data as gaitfit's
+    /// per-frame CSV.
+    Inspect(inspect::Args),
     /// Edit runs and walks live in a local web page (127.0.0.1 only).
     Studio(studio::Args),
 }
@@ -50,6 +54,7 @@ pub fn main() -> ExitCode {
         Command::Export(a) => export::run(a),
         Command::Events(a) => events::run(a),
         Command::Generate(a) => generate::run(a),
+        Command::Inspect(a) => inspect::run(a),
         Command::Studio(a) => studio::run(a),
     };
     match result {
