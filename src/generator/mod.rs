@@ -2,6 +2,7 @@
 //! shared by the running (RUNNER), walking (KLAW) and generalization (Ko–Badler) generators.
 pub mod anthropometry;
 pub mod checks;
+pub mod curves;
 pub mod generalize;
 pub mod ik;
 pub mod motion;

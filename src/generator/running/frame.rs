@@ -3,13 +3,13 @@
 //! generator computed (which equal the skeleton's forward kinematics).
 use glam::{DQuat, DVec3};
 
-use super::curves::hermite;
 use super::dims::{
     leg_fk, leg_ik, leg_orientations, pelvis_orientation, LegAngles, LegPoints, RunnerDims,
 };
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, StanceMode};
 use super::state::{StepKind, StepPlan};
 use super::upper_body::{arm_drivers, fill_upper};
+use crate::generator::curves::hermite;
 use crate::generator::skeleton::{Joint, Pose};
 
 /// Per-frame facts besides the pose.

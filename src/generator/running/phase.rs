@@ -6,9 +6,9 @@
 use glam::{DVec2, DVec3};
 
 use super::attributes::Strike;
-use super::curves::hermite;
 use super::dims::{leg_fk, leg_ik, pelvis_matrix, rot2, LegAngles, LegPoints, RunnerDims};
 use super::state::{StepKind, StepPlan, G};
+use crate::generator::curves::hermite;
 
 /// How the stance foot touches the ground at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,9 +16,10 @@ use glam::{DVec2, DVec3};
 use nalgebra::{Matrix2, Vector2};
 
 use super::attributes::{hidden_impact_pitch, Effective, Strike};
-use super::curves::{c2_mid_velocity, Key, KneeBump, Seg3, Track};
+use super::curves::{Key, KneeBump, Track};
 use super::dims::{leg_fk, leg_ik, pelvis_matrix, pitch_from_down, rot2, LegAngles, RunnerDims};
 use super::phase::{hip_at, orient_at, pelvis_at, stance_leg, stance_leg_in, StanceMode};
+use crate::generator::curves::{c2_mid_velocity, Seg3};
 use crate::generator::GenerateError;
 
 /// Gravitational acceleration used in eq. 3 and the flight parabola, m/s².

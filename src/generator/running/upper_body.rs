@@ -13,8 +13,8 @@
 //! and facing forward. Local rotations are parent⁻¹ · child, so the head is exactly level.
 use glam::DQuat;
 
-use super::curves::hermite;
 use super::state::{StepKind, StepPlan, UpperAttrs};
+use crate::generator::curves::hermite;
 use crate::generator::skeleton::{Joint, Pose};
 
 #[inline]

@@ -130,13 +130,6 @@ impl FootPoints {
     }
 }
 
-/// `3s² − 2s³` on [0, 1] (clamped): a C¹ blend used for the kinematic interpolations.
-#[inline]
-pub fn smoothstep(s: f64) -> f64 {
-    let s = s.clamp(0.0, 1.0);
-    s * s * (3.0 - 2.0 * s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,7 +9,7 @@ use super::attributes::WalkAttributes;
 use super::body::Body;
 use super::collision::{self, SwingAtImpact};
 use super::dynamics::{HipMotion, StanceModel};
-use super::foot::{smoothstep, FootShape};
+use super::foot::FootShape;
 use super::high_level::{heel_strike, phase_times, Locomotion, PhaseTimes, WalkRelations};
 use super::stance::{StanceRun, StanceSpec, StanceStart};
 use super::stop::{Closing, StopStart};
@@ -18,6 +18,7 @@ use super::virtual_leg::{
     smooth_roll, FootPeriod, LegPose, VirtualLeg, KNEE_SOFT, TOE_OFF_KNEE_RATE,
 };
 use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
+use crate::generator::curves::smoothstep;
 use crate::generator::ik::leg_ik;
 use crate::generator::motion::{Motion, MotionMetadata};
 use crate::generator::skeleton::{Euler, Joint, Skeleton};

@@ -62,10 +62,10 @@
 //! here the shooting makes it reach that length exactly at the end, so that lock never engages
 //! and is not implemented.
 use super::dynamics::{solve2, StanceModel};
-use super::foot::smoothstep;
 use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_2d_with, Solved};
 use super::track::{Node, Track};
+use crate::generator::curves::smoothstep;
 
 /// Half-width of the kinematic blend that spreads the lock's rate jump, s (the leg is drawn
 /// decelerating to the lock over 2 × 20 ms).

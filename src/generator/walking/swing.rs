@@ -27,10 +27,11 @@
 //! their toe-off and heel-strike values.
 use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
-use super::foot::{smoothstep, FootPoints, FootShape};
+use super::foot::{FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_1d, solve_1d_with, solve_2d_with, Solved};
 use super::track::{Node, Track};
+use crate::generator::curves::smoothstep;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::f64::consts::FRAC_PI_2;
@@ -583,10 +584,9 @@ impl ThighPath {
 }
 
 /// The cubic Hermite from `(value, rate)` `p0` at `a` to `p1` at `b`: value, rate and
-/// acceleration at `t` ([`crate::generator::running::curves::hermite_acc`]).
+/// acceleration at `t` ([`crate::generator::curves::hermite_acc`]).
 fn hermite(a: f64, b: f64, p0: [f64; 2], p1: [f64; 2], t: f64) -> [f64; 3] {
-    let (v, d, dd) =
-        crate::generator::running::curves::hermite_acc(a, b, p0[0], p1[0], p0[1], p1[1], t);
+    let (v, d, dd) = crate::generator::curves::hermite_acc(a, b, p0[0], p1[0], p0[1], p1[1], t);
     [v, d, dd]
 }
 

@@ -24,7 +24,8 @@
 //! in 3D reaches its ankle exactly.
 use super::attributes::WalkAttributes;
 use super::body::Body;
-use super::foot::{smoothstep, toe_blend, FootShape};
+use super::foot::{toe_blend, FootShape};
+use crate::generator::curves::smoothstep;
 use std::f64::consts::FRAC_PI_2;
 
 /// Width of the knee's soft straightening in late stance, m.
