@@ -272,3 +272,49 @@ fn ko_badler_lines_have_per_output_variances_and_checked_bounded_solves() {
     assert_eq!(b.converged, b.solves);
     assert!(cr1.loso_rmse.is_some());
 }
+
+/// Huber (`--robust`): the M-estimate, its scale and Huber's H1 sandwich standard errors against
+/// statsmodels RLM (`tools/reference/robust.json`, made by `tools/reference/robust.py`:
+/// `RLM(y, X, M=HuberT(1.345)).fit(scale_est='mad', cov='H1')` on the same rows).
+#[test]
+fn huber_standard_errors_match_statsmodels_rlm_h1() {
+    let p = root().join("tools/reference/robust.json");
+    let want: Value =
+        serde_json::from_str(&std::fs::read_to_string(&p).expect("reference file")).expect("json");
+    let tables = bundled();
+    for (id, names) in [
+        ("walk-tds-sf", &["d0", "d1"][..]),
+        ("walk-sl-sf", &["k"][..]),
+    ] {
+        let w = &want[id];
+        let opts = FitOptions {
+            robust: true,
+            ..FitOptions::default()
+        };
+        let rel = by_id(id).expect("relation");
+        let rec = fit_relation(rel.as_ref(), &tables, &opts)
+            .expect("fit")
+            .record;
+        assert_eq!(rec.n as f64, num(&w["n"]), "{id} rows");
+        let rob = rec.robust.as_ref().expect("robust record");
+        assert!(rob.converged, "{id}: IRLS did not converge");
+        close(rob.scale, num(&w["scale"]), 1e-6, &format!("{id} scale"));
+        assert_eq!(rob.rows_downweighted as f64, num(&w["rows_downweighted"]));
+        let coefs = nums(&w["coef"]);
+        let ses = nums(&w["se_h1"]);
+        for (j, name) in names.iter().enumerate() {
+            let c = rob
+                .coefficients
+                .iter()
+                .find(|c| c.name == *name)
+                .expect("robust coefficient");
+            close(c.value, coefs[j], 1e-6, &format!("{id} {name}"));
+            close(
+                c.std_error.expect("robust se"),
+                ses[j],
+                1e-6,
+                &format!("{id} {name} H1 se"),
+            );
+        }
+    }
+}

@@ -50,6 +50,25 @@ fn round_table(path: &Path) {
     std::fs::write(path, out).unwrap();
 }
 
+/// Drops the steps whose step frequency lies outside `[lo, hi]` (steps/min).
+fn keep_fitted_range(path: &Path, (lo, hi): (f64, f64)) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap();
+    let col = head
+        .split(',')
+        .position(|h| h == "step_freq_steps_per_min")
+        .unwrap();
+    let mut out = format!("{head}\n");
+    for l in lines {
+        let sf: f64 = l.split(',').nth(col).unwrap().parse().unwrap();
+        if (lo..=hi).contains(&sf) {
+            out += &format!("{l}\n");
+        }
+    }
+    std::fs::write(path, out).unwrap();
+}
+
 #[test]
 fn generated_steps_refit_to_the_generating_coefficients() {
     let fits = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fits");
@@ -70,6 +89,14 @@ fn generated_steps_refit_to_the_generating_coefficients() {
     std::fs::write(dir.path().join("sched_1.6.csv"), schedule(18.0)).unwrap();
     std::fs::write(dir.path().join("sched_1.8.csv"), schedule(21.0)).unwrap();
     std::fs::write(dir.path().join("sched_1.95.csv"), schedule(21.0)).unwrap();
+    // The generator follows eqs. 4–5 only inside the step frequencies the generating fit saw;
+    // beyond them it holds the boundary value (relations::FittedRange), so only the steps
+    // inside that range carry the curve to refit.
+    let v: Value =
+        serde_json::from_slice(&std::fs::read(fits.join("run-tflight-sf.json")).unwrap()).unwrap();
+    let r = &v["valid_range"][0];
+    assert_eq!(r["input"], "sf");
+    let sf_range = (r["lo"].as_f64().unwrap(), r["hi"].as_f64().unwrap());
     let mut tables = Vec::new();
     for h in ["1.6", "1.8", "1.95"] {
         let steps = dir.path().join(format!("steps_{h}.csv"));
@@ -97,6 +124,7 @@ fn generated_steps_refit_to_the_generating_coefficients() {
         // at its published value — a limitation of `gaitfit fit` on noise-free data, not of
         // the generated steps.
         round_table(&steps);
+        keep_fitted_range(&steps, sf_range);
         tables.push(steps);
     }
     let out = dir.path().join("refit");

@@ -461,8 +461,8 @@ proptest! {
     /// the arms followed a phase) that case measured 3.60 (l_ankle), and a grid over 2–6 km/h
     /// every 0.05 × 1.5–2.0 m every 0.05 passed every check both then and now (continuity ≤ 4.20
     /// over 2–6.5 km/h every 0.02 × every 0.01 m, at an ankle). Faster, beyond eq. 5's data
-    /// (> 209 steps/min) its cubic rises to
-    /// 0.231 s of flight, which the generator refuses (see
+    /// (> 209 steps/min), the fitted relation holds its boundary value (it once followed its
+    /// cubic to 0.231 s of flight, which the generator refused; see
     /// `refitted_relations_refuse_too_short_supports`). Eq. 5's real-data flights (~0.1 s at
     /// 18 km/h against the published 0.19 s) leave long supports (1.1 m of ground); the landing
     /// moves ahead for them (`refitted_long_supports_land_ahead`).
@@ -613,7 +613,8 @@ fn refitted_model(h: f64) -> RunModel {
 }
 
 /// With the refitted relations at 4–25 km/h: a natural step whose eq. 5 flight leaves less
-/// than a quarter of the step for support is refused (with a message), never generated.
+/// than a quarter of the step for support is refused (with a message), never generated; every
+/// other step is generated.
 #[test]
 fn refitted_relations_refuse_too_short_supports() {
     let mut refused = 0;
@@ -633,10 +634,11 @@ fn refitted_relations_refuse_too_short_supports() {
             }
         }
     }
-    assert!(
-        refused > 0,
-        "the refitted eq. 5 was expected to overreach somewhere"
-    );
+    // The refitted eq. 5 once overreached here (its cubic followed past the fitted step
+    // frequencies, 0.231 s at 230 steps/min); the fitted relation now holds the boundary value
+    // beyond its range (relations::FittedRange), so whether any step is refused depends only on
+    // the held curve: each case above checks that refusal and the rule agree.
+    println!("{refused} of 66 natural steps refused");
 }
 
 /// The arms at sprint cadences (locked speed, raised step frequency; stance ≈ 65 ms at

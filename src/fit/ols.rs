@@ -875,13 +875,22 @@ fn two_prod(a: f64, b: f64) -> (f64, f64) {
 /// A Huber M-estimate fitted by iteratively reweighted least squares.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HuberFit {
-    /// The final weighted least-squares fit (weights = user weights × robust weights). Its
-    /// standard errors are those of that weighted fit — the usual IRLS approximation, not
-    /// Huber's sandwich formula.
+    /// The final weighted least-squares fit (weights = user weights × robust weights): its
+    /// coefficients are the M-estimate; its `cov`/`std_error` are the weighted fit's at the
+    /// final weights, *not* the M-estimate's (use [`HuberFit::cov`]).
     pub fit: LinearFit,
+    /// Covariance of the M-estimate: Huber's (1981, eq. 7.6.4) sandwich with his small-sample
+    /// correction, `H1` exactly as statsmodels `RLM(...).fit(cov='H1')` (its default):
+    /// `κ² · [Σψ(rᵢ)²/(n − p)] · s² / [Σψ'(rᵢ)/n]² · (XᵀWX)⁻¹` with `rᵢ = √wᵢ eᵢ/s`,
+    /// `κ = 1 + (p/n)·var(ψ')/mean(ψ')²` (population variance) and `s` the MAD scale of the
+    /// final residuals. With user weights the rows are scaled by `√wᵢ` first.
+    pub cov: DMatrix<f64>,
+    /// `sqrt(diag cov)`.
+    pub std_error: DVector<f64>,
     /// Robust weights `min(1, k·s/|rᵢ|)` of the last iteration (1 = not down-weighted).
     pub robust_weights: DVector<f64>,
-    /// Robust residual scale `s = 1.4826·median|rᵢ|` of the last iteration.
+    /// Robust residual scale `s = 1.4826·median|√wᵢ eᵢ|` of the final residuals (as statsmodels
+    /// RLM reports it).
     pub scale: f64,
     /// The tuning constant `k` (1.345 gives 95 % efficiency under normal errors).
     pub k: f64,
@@ -909,6 +918,12 @@ pub fn huber_irls(p: &LinearProblem, k: f64, max_iter: usize) -> Result<HuberFit
         None => DVector::from_element(n, 1.0),
     };
     let mut fit = ols(p)?;
+    // (XᵀWX)⁻¹ from the plain fit (σ²(XᵀWX)⁻¹ / σ²), solved in its equilibrated basis.
+    let plain_cov = if fit.sigma > 0.0 {
+        &fit.cov / (fit.sigma * fit.sigma)
+    } else {
+        DMatrix::from_element(fit.p, fit.p, f64::NAN)
+    };
     let mut u = DVector::from_element(n, 1.0);
     let mut scale = f64::NAN;
     let mut converged = false;
@@ -944,14 +959,55 @@ pub fn huber_irls(p: &LinearProblem, k: f64, max_iter: usize) -> Result<HuberFit
             break;
         }
     }
+    // The scale of the final residuals, and the H1 sandwich at them (statsmodels RLM).
+    let r: Vec<f64> = (0..n)
+        .map(|i| base_w[i].sqrt() * fit.residuals[i])
+        .collect();
+    let abs_r: Vec<f64> = r.iter().map(|v| v.abs()).collect();
+    let s_final = MAD_TO_SIGMA * stats::median(&abs_r);
+    if s_final > 0.0 {
+        scale = s_final;
+    }
+    let cov = huber_h1(&plain_cov, &r, scale, k, n, fit.p);
+    let std_error = cov.diagonal().map(|v| v.max(0.0).sqrt());
     Ok(HuberFit {
         fit,
+        cov,
+        std_error,
         robust_weights: u,
         scale,
         k,
         iterations,
         converged,
     })
+}
+
+/// Huber's H1 covariance (see [`HuberFit::cov`]) from `(XᵀWX)⁻¹` (`unscaled`), the √w-scaled
+/// residuals `r`, the scale `s` and tuning constant `k`. NaN when no residual lies inside ±k·s
+/// (ψ' is then 0 everywhere: the M-estimate has no asymptotic variance).
+fn huber_h1(
+    unscaled: &DMatrix<f64>,
+    r: &[f64],
+    s: f64,
+    k: f64,
+    n: usize,
+    p: usize,
+) -> DMatrix<f64> {
+    let nf = n as f64;
+    let (mut ss_psi, mut n_in) = (0.0, 0.0);
+    for &ri in r {
+        let z = if s > 0.0 { ri / s } else { 0.0 };
+        ss_psi += z.clamp(-k, k).powi(2);
+        if z.abs() <= k {
+            n_in += 1.0;
+        }
+    }
+    // ψ' is 1 inside ±k and 0 outside: mean m = n_in/n, population variance m(1 − m).
+    let m = n_in / nf;
+    let var_d = m * (1.0 - m);
+    let kappa = 1.0 + p as f64 / nf * var_d / (m * m);
+    let factor = kappa * kappa * (ss_psi / (nf - p as f64)) * s * s / (m * m);
+    unscaled * factor
 }
 
 #[cfg(test)]

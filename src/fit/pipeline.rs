@@ -1432,7 +1432,7 @@ pub fn fit_relation(
             rmse: pub_rmse,
         },
         valid_range,
-        outside_range: None,
+        outside_range: Some(crate::relations::OUTSIDE_RANGE_RULE.to_string()),
         inference: Some(inference),
         breakpoints: bp_records,
         bounded: col_bounds.as_ref().map(|_| box_stats.to_record()),
@@ -1452,8 +1452,15 @@ pub fn fit_relation(
         bootstrap,
         notes,
     };
+    // The refit knows the range it was fitted on (predictions beyond it hold the boundary).
+    let mut refit = rel.with_values(&values, levels);
+    let mut fitted_range = crate::relations::FittedRange::default();
+    for (b, g) in fitted_range.bounds.iter_mut().zip(&record.valid_range) {
+        *b = (g.lo <= g.hi).then_some([g.lo, g.hi]);
+    }
+    refit.set_fitted_range(fitted_range);
     Ok(FitOutcome {
-        refit: rel.with_values(&values, levels),
+        refit,
         published: rel.with_values(&published, BTreeMap::new()),
         record,
         prepared: prep,
@@ -1518,7 +1525,8 @@ fn robust_refit(
     let lm = rel.basis_to_params(p, free);
     let gmap = &lm.map * e;
     let rout = &gmap * &h.fit.coef + &lm.shift;
-    let rcov = &gmap * &h.fit.cov * gmap.transpose();
+    // Huber's H1 sandwich (statsmodels RLM's default), not the last weighted fit's covariance.
+    let rcov = &gmap * &h.cov * gmap.transpose();
     let df = h.fit.df_resid as f64;
     let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
     let mut rc = Vec::new();
@@ -1557,7 +1565,16 @@ fn robust_refit(
         iterations: h.iterations,
         converged: h.converged,
         rows_downweighted: h.robust_weights.iter().filter(|&&u| u < 1.0).count(),
-        cov: None,
+        cov: Some(format!(
+            "Huber's sandwich with his small-sample correction (H1, as statsmodels RLM's \
+             default): κ²·[Σψ²/(n − p)]·s²/[Σψ'/n]²·(XᵀWX)⁻¹ on the design at the breakpoint \
+             estimates{}; rows treated as independent; intervals t with {df} df",
+            if nfe > 0 {
+                " with one slope column per subject (the global slope is their mean)"
+            } else {
+                ""
+            }
+        )),
         coefficients: rc,
     })
 }

@@ -45,8 +45,8 @@
 //! assert_eq!(r.outputs(), 4);
 //! ```
 use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
-    ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
+    Observation, ParamKind, ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;
 use crate::fit::nonlinear::Model;
@@ -194,6 +194,8 @@ fn params() -> &'static [ParameterSpec] {
 pub struct KbMu {
     values: Vec<f64>,
     levels: BTreeMap<String, f64>,
+    /// The fitted input range (from a fits file; empty otherwise).
+    range: FittedRange,
 }
 
 impl KbMu {
@@ -205,12 +207,17 @@ impl KbMu {
         KbMu {
             values: params().iter().map(|s| s.published).collect(),
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// From a coefficient set.
     pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
         let (values, levels) = set.split(params(), None)?;
-        Ok(KbMu { values, levels })
+        Ok(KbMu {
+            values,
+            levels,
+            range: FittedRange::of(set, INPUTS),
+        })
     }
     /// From `fits/kb-mu.json`.
     pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
@@ -353,6 +360,12 @@ impl Relation for KbMu {
     fn values(&self) -> &[f64] {
         &self.values
     }
+    fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
+    }
     fn subject_levels(&self) -> &BTreeMap<String, f64> {
         &self.levels
     }
@@ -381,6 +394,7 @@ impl Relation for KbMu {
         Box::new(KbMu {
             values: values.to_vec(),
             levels,
+            range: FittedRange::default(),
         })
     }
 }

@@ -505,6 +505,27 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
         self.predict_with(self.values(), 0.0, x)
     }
 
+    /// The input range the coefficients were fitted on (read from the fits file; empty for the
+    /// published coefficients and for relations built in memory).
+    fn fitted_range(&self) -> FittedRange {
+        FittedRange::default()
+    }
+
+    /// Sets the fitted input range (relations that keep none ignore it).
+    fn set_fitted_range(&mut self, _range: FittedRange) {}
+
+    /// [`Relation::predict`] with the rule of [`FittedRange`]: whether `x` lies inside the
+    /// fitted range, and outside it the boundary value held (inputs clamped to `[lo, hi]`).
+    fn predict_checked(&self, x: &[f64]) -> Prediction {
+        let r = self.fitted_range();
+        let at = r.hold(x);
+        Prediction {
+            value: self.predict(&at),
+            inside: r.contains(x),
+            at,
+        }
+    }
+
     /// Analytic gradient of the prediction with respect to all global parameters, when
     /// available. The default gives the linear part exactly and leaves breakpoints to the
     /// caller (`None`).
@@ -679,6 +700,80 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// The input range a relation's coefficients were fitted on (a fits file's `valid_range`),
+/// one `[lo, hi]` per input in [`Relation::inputs`] order (`None`: not recorded, e.g. the
+/// published coefficients).
+///
+/// # Beyond the fitted range (the rule every prediction follows)
+/// [`Relation::predict_checked`] reports whether the inputs lie inside the range and, outside
+/// it, **holds the boundary value**: each input is clamped to `[lo, hi]` before the relation is
+/// evaluated, so no fitted curve is followed where no data constrained it. The typed methods the
+/// generators call follow the same rule for polynomial pieces of degree ≥ 2
+/// ([`RunTflightSf::flight_time`]: the cubic past the data ran to 0.231 s at 230 steps/min);
+/// the relations that are straight lines in their inputs ([`RunSlV`], [`WalkSlSf`],
+/// [`WalkTdsSf`], [`KbMu`]) extrapolate their line in the typed methods, which the generators
+/// invert (a line cannot turn back the way a cubic does), while `predict_checked` holds.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FittedRange {
+    /// `[lo, hi]` per input.
+    pub bounds: [Option<[f64; 2]>; MAX_INPUTS],
+}
+
+impl FittedRange {
+    /// The range of `inputs` recorded in `set` (inputs matched by symbol).
+    pub fn of(set: &CoefficientSet, inputs: &[Variable]) -> FittedRange {
+        let mut r = FittedRange::default();
+        for (j, v) in inputs.iter().enumerate().take(MAX_INPUTS) {
+            r.bounds[j] = set
+                .ranges
+                .iter()
+                .find(|(name, lo, hi)| name == v.symbol && lo <= hi)
+                .map(|&(_, lo, hi)| [lo, hi]);
+        }
+        r
+    }
+    /// Whether every input with a recorded range lies inside it (NaN inputs are outside).
+    pub fn contains(&self, x: &[f64]) -> bool {
+        x.iter().zip(&self.bounds).all(|(&v, b)| match b {
+            Some([lo, hi]) => v >= *lo && v <= *hi,
+            None => true,
+        })
+    }
+    /// Input `j` held at the range's boundary (unchanged without a recorded range).
+    pub fn hold_input(&self, j: usize, v: f64) -> f64 {
+        match self.bounds.get(j).copied().flatten() {
+            Some([lo, hi]) => v.clamp(lo, hi),
+            None => v,
+        }
+    }
+    /// All inputs held at the range's boundary.
+    pub fn hold(&self, x: &[f64]) -> [f64; MAX_INPUTS] {
+        let mut out = [0.0; MAX_INPUTS];
+        for (j, (o, &v)) in out.iter_mut().zip(x).enumerate() {
+            *o = self.hold_input(j, v);
+        }
+        out
+    }
+}
+
+/// A prediction with where it was evaluated ([`Relation::predict_checked`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prediction {
+    /// The predicted response (papers' units), at `at`.
+    pub value: f64,
+    /// Whether the inputs asked for lie inside the fitted range ([`FittedRange`]); always true
+    /// when no range is recorded.
+    pub inside: bool,
+    /// The inputs the relation was evaluated at: those asked for, held at the range's boundary.
+    pub at: [f64; MAX_INPUTS],
+}
+
+/// The text a fit record carries under `outside_range` (the rule of [`FittedRange`]).
+pub const OUTSIDE_RANGE_RULE: &str = "predictions report whether their inputs lie inside \
+    valid_range; outside it gaitfit holds the boundary value (each input clamped to [lo, hi] \
+    before evaluating: Relation::predict_checked); the generators' polynomial pieces of degree \
+    ≥ 2 (run-tflight-sf) do the same, straight-line relations extrapolate their line";
+
 /// A named set of coefficient values for one relation (what a fits file carries).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct CoefficientSet {
@@ -686,6 +781,8 @@ pub struct CoefficientSet {
     pub relation: String,
     /// `(name, value)` in file order; per-subject effects are named `<stem>[<subject>]`.
     pub values: Vec<(String, f64)>,
+    /// `(input symbol, lo, hi)`: the fitted range (`valid_range`), empty when not recorded.
+    pub ranges: Vec<(String, f64, f64)>,
 }
 
 impl CoefficientSet {
@@ -712,9 +809,17 @@ impl CoefficientSet {
             value: f64,
         }
         #[derive(serde::Deserialize)]
+        struct R {
+            input: String,
+            lo: Option<f64>,
+            hi: Option<f64>,
+        }
+        #[derive(serde::Deserialize)]
         struct F {
             relation: String,
             coefficients: Vec<C>,
+            #[serde(default)]
+            valid_range: Vec<R>,
         }
         let f: F = serde_json::from_str(text).map_err(|e| RelationError::Format {
             path: path.to_path_buf(),
@@ -726,6 +831,11 @@ impl CoefficientSet {
                 .coefficients
                 .into_iter()
                 .map(|c| (c.name, c.value))
+                .collect(),
+            ranges: f
+                .valid_range
+                .into_iter()
+                .filter_map(|r| Some((r.input, r.lo?, r.hi?)))
                 .collect(),
         })
     }
@@ -797,7 +907,9 @@ pub fn by_id(id: &str) -> Result<Box<dyn Relation>, RelationError> {
 pub fn from_coefficients(set: &CoefficientSet) -> Result<Box<dyn Relation>, RelationError> {
     let r = by_id(&set.relation)?;
     let (vals, levels) = set.split(r.parameters(), r.subject_effect())?;
-    Ok(r.with_values(&vals, levels))
+    let mut out = r.with_values(&vals, levels);
+    out.set_fitted_range(FittedRange::of(set, out.inputs()));
+    Ok(out)
 }
 
 /// Loads `fits/<id>.json` as a relation with the refitted coefficients.

@@ -20,9 +20,10 @@
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
 use super::{
-    expect_id, linear_gradient, required, sorted_keys, Citation, CoefficientSet, Domain, KeyRange,
-    KeyScale, KeySums, NormalEquations, Observation, ParamKind, ParameterSpec, Plan, Rejection,
-    Relation, RelationError, SortedProfile, SubjectEffect, Variable,
+    expect_id, linear_gradient, required, sorted_keys, Citation, CoefficientSet, Domain,
+    FittedRange, KeyRange, KeyScale, KeySums, NormalEquations, Observation, ParamKind,
+    ParameterSpec, Plan, Rejection, Relation, RelationError, SortedProfile, SubjectEffect,
+    Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -78,6 +79,8 @@ const INPUTS: &[Variable] = &[
 pub struct RunSlV {
     values: Vec<f64>,
     levels: BTreeMap<String, f64>,
+    /// The fitted input range (from a fits file; empty otherwise).
+    range: FittedRange,
 }
 
 impl RunSlV {
@@ -89,6 +92,7 @@ impl RunSlV {
         RunSlV {
             values: PARAMS.iter().map(|p| p.published).collect(),
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// Explicit coefficients.
@@ -96,12 +100,17 @@ impl RunSlV {
         RunSlV {
             values: vec![a, b, v_norm],
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// From a coefficient set (e.g. a fits file's).
     pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
         let (values, levels) = set.split(PARAMS, Some(LEVEL))?;
-        Ok(RunSlV { values, levels })
+        Ok(RunSlV {
+            values,
+            levels,
+            range: FittedRange::of(set, INPUTS),
+        })
     }
     /// From `fits/run-sl-v.json` written by `gaitfit fit`.
     pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
@@ -246,6 +255,12 @@ impl Relation for RunSlV {
     fn values(&self) -> &[f64] {
         &self.values
     }
+    fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
+    }
     fn subject_levels(&self) -> &BTreeMap<String, f64> {
         &self.levels
     }
@@ -273,6 +288,7 @@ impl Relation for RunSlV {
         Box::new(RunSlV {
             values: values.to_vec(),
             levels,
+            range: FittedRange::default(),
         })
     }
     fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {

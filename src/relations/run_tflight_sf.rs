@@ -31,9 +31,9 @@
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
 use super::{
-    expect_id, required, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, KeyRange,
-    KeyScale, KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec, Plan,
-    Rejection, Relation, RelationError, SortedProfile, Variable,
+    expect_id, required, sorted_keys, Citation, CoefficientSet, Domain, FeatureSums, FittedRange,
+    KeyRange, KeyScale, KeySums, LinearMap, NormalEquations, Observation, ParamKind, ParameterSpec,
+    Plan, Rejection, Relation, RelationError, SortedProfile, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -138,6 +138,8 @@ pub struct RunTflightSf {
     values: Vec<f64>,
     continuity: Continuity,
     levels: BTreeMap<String, f64>,
+    /// The fitted input range (from a fits file; empty otherwise).
+    range: FittedRange,
 }
 
 /// Minimum number of distinct step frequencies a piece needs to be fitted.
@@ -155,6 +157,7 @@ impl RunTflightSf {
             values: PARAMS.iter().map(|p| p.published).collect(),
             continuity: Continuity::Free,
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// The published coefficients in the continuous variant (as published they still jump at
@@ -171,6 +174,7 @@ impl RunTflightSf {
             values: values.to_vec(),
             continuity,
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// From a coefficient set; the variant follows the set's relation id.
@@ -184,6 +188,7 @@ impl RunTflightSf {
             values,
             continuity,
             levels,
+            range: FittedRange::of(set, INPUTS),
         })
     }
     /// From `fits/run-tflight-sf.json` or `fits/run-tflight-sf-continuous.json`.
@@ -202,9 +207,16 @@ impl RunTflightSf {
     pub fn coefficients(&self) -> &[f64] {
         &self.values
     }
-    /// Flight time (s) at step frequency `sf` (steps/min).
+    /// Flight time (s) at step frequency `sf` (steps/min). Coefficients read from a fits file
+    /// hold the boundary value outside the fitted range of sf ([`super::FittedRange`]): the
+    /// cubic is not followed where no step constrained it (the published coefficients keep the
+    /// paper's pieces, constant beyond k2).
     pub fn flight_time(&self, sf: f64) -> f64 {
-        tflight(&self.values, sf)
+        tflight(&self.values, self.range.hold_input(0, sf))
+    }
+    /// Whether `sf` (steps/min) lies inside the fitted range (always true without one).
+    pub fn in_fitted_range(&self, sf: f64) -> bool {
+        self.range.contains(&[sf])
     }
     /// cubic(k1) − quadratic(k1), s: the discontinuity at the first knot.
     pub fn jump_at_k1(&self) -> f64 {
@@ -355,6 +367,12 @@ impl Relation for RunTflightSf {
     }
     fn values(&self) -> &[f64] {
         &self.values
+    }
+    fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
     }
     fn subject_levels(&self) -> &BTreeMap<String, f64> {
         &self.levels
@@ -576,6 +594,7 @@ impl Relation for RunTflightSf {
             values: values.to_vec(),
             continuity: self.continuity,
             levels,
+            range: FittedRange::default(),
         })
     }
     fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {

@@ -18,8 +18,8 @@
 //! assert!((w.step_length_for_speed(v, 1.8) - 0.7746).abs() < 0.0005);
 //! ```
 use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
-    ParameterSpec, Rejection, Relation, RelationError, Variable,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
+    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -54,6 +54,8 @@ const INPUTS: &[Variable] = &[
 pub struct WalkSlSf {
     values: Vec<f64>,
     levels: BTreeMap<String, f64>,
+    /// The fitted input range (from a fits file; empty otherwise).
+    range: FittedRange,
 }
 
 impl WalkSlSf {
@@ -69,12 +71,17 @@ impl WalkSlSf {
         WalkSlSf {
             values: vec![k],
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// From a coefficient set.
     pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
         let (values, levels) = set.split(PARAMS, None)?;
-        Ok(WalkSlSf { values, levels })
+        Ok(WalkSlSf {
+            values,
+            levels,
+            range: FittedRange::of(set, INPUTS),
+        })
     }
     /// From `fits/walk-sl-sf.json`.
     pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
@@ -166,6 +173,12 @@ impl Relation for WalkSlSf {
     fn values(&self) -> &[f64] {
         &self.values
     }
+    fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
+    }
     fn subject_levels(&self) -> &BTreeMap<String, f64> {
         &self.levels
     }
@@ -179,6 +192,7 @@ impl Relation for WalkSlSf {
         Box::new(WalkSlSf {
             values: values.to_vec(),
             levels,
+            range: FittedRange::default(),
         })
     }
 }

@@ -17,8 +17,8 @@
 //! assert!((w.double_support_time(120.0) - 0.0988).abs() < 1e-12);
 //! ```
 use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, Observation, ParamKind,
-    ParameterSpec, Rejection, Relation, RelationError, Variable,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
+    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -56,6 +56,8 @@ const INPUTS: &[Variable] = &[Variable {
 pub struct WalkTdsSf {
     values: Vec<f64>,
     levels: BTreeMap<String, f64>,
+    /// The fitted input range (from a fits file; empty otherwise).
+    range: FittedRange,
 }
 
 impl WalkTdsSf {
@@ -71,12 +73,17 @@ impl WalkTdsSf {
         WalkTdsSf {
             values: vec![d0, d1],
             levels: BTreeMap::new(),
+            range: FittedRange::default(),
         }
     }
     /// From a coefficient set.
     pub fn from_coefficients(set: &CoefficientSet) -> Result<Self, RelationError> {
         let (values, levels) = set.split(PARAMS, None)?;
-        Ok(WalkTdsSf { values, levels })
+        Ok(WalkTdsSf {
+            values,
+            levels,
+            range: FittedRange::of(set, INPUTS),
+        })
     }
     /// From `fits/walk-tds-sf.json`.
     pub fn from_fit_file(path: &Path) -> Result<Self, RelationError> {
@@ -160,6 +167,12 @@ impl Relation for WalkTdsSf {
     fn values(&self) -> &[f64] {
         &self.values
     }
+    fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
+    }
     fn subject_levels(&self) -> &BTreeMap<String, f64> {
         &self.levels
     }
@@ -174,6 +187,7 @@ impl Relation for WalkTdsSf {
         Box::new(WalkTdsSf {
             values: values.to_vec(),
             levels,
+            range: FittedRange::default(),
         })
     }
 }
