@@ -87,8 +87,8 @@ fn rational(x: f64, b: &[f64], nn: usize, nd: usize) -> (f64, f64) {
 }
 fn rational_g(x: f64, b: &[f64], nn: usize, nd: usize, g: &mut [f64]) {
     let (num, den) = rational(x, b, nn, nd);
-    for k in 0..nn {
-        g[k] = x.powi(k as i32) / den;
+    for (k, gk) in g.iter_mut().enumerate().take(nn) {
+        *gk = x.powi(k as i32) / den;
     }
     for k in 0..nd {
         g[nn + k] = -num * x.powi(k as i32 + 1) / (den * den);
@@ -404,7 +404,8 @@ fn nist_nls_extra_both_starts() {
                             d.name, fit.converged, fit.termination, fit.theta
                         ));
                     }
-                    if !unresolvable && !(sd >= 6.0 && rs >= 6.0) {
+                    let digits = sd >= 6.0 && rs >= 6.0;
+                    if !(unresolvable || digits) {
                         failures.push(format!(
                             "{} start {k}: SD LRE {sd:.2}, residual SD LRE {rs:.2}",
                             d.name
