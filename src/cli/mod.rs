@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
+pub mod calibrate;
 pub mod check;
 pub mod events;
 pub mod export;
@@ -41,6 +42,9 @@ pub enum Command {
     Inspect(inspect::Args),
     /// Edit runs and walks live in a local web page (127.0.0.1 only).
     Studio(studio::Args),
+    /// Measured trials → relations → generated gait → the same measurement → residuals and a
+    /// per-subject calibration (report.html, residuals.csv, calibrated.json).
+    Calibrate(calibrate::Args),
 }
 
 /// Runs the command line; returns the process exit code (0 success, 1 check failed or error,
@@ -56,6 +60,7 @@ pub fn main() -> ExitCode {
         Command::Generate(a) => generate::run(a),
         Command::Inspect(a) => inspect::run(a),
         Command::Studio(a) => studio::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
     };
     match result {
         Ok(code) => code,

@@ -1,0 +1,554 @@
+//! `gaitfit calibrate`: measured trials → relations → generated gait → the same measurement →
+//! residuals, then a per-subject calibration of the generator attributes the residuals identify.
+//!
+//! For every subject × condition (trial): the events and steps are detected
+//! ([`measure::measure`]), walk or run decided from the data ([`measure::gait_from_data`]);
+//! the matching generator (RUNNER for runs, KLAW for walks) is driven at the measured speed and
+//! the subject's body size ([`drive::drive`]); the generated motion is measured by the same
+//! event pipeline; residuals are generated − measured.
+//!
+//! Two stages: `relations` (the relations of `--fits`, or refitted on the inputs, with zero
+//! offsets and the generators' default attributes) and `calibrated` (the attributes of
+//! [`drive::RUN_ATTRS`] / [`drive::WALK_ATTRS`] found by Gauss–Newton, argmin's
+//! `GaussNewton`, on the objective of [`solve`]).
+pub mod drive;
+pub mod measure;
+pub mod output;
+pub mod solve;
+
+use crate::events::input::{expand_inputs, read_input};
+use crate::events::steps::subject_label;
+use crate::events::{EventError, Gait};
+use crate::ingest::types::Trial;
+use crate::ingest::ReadOptions;
+use drive::{DriveOptions, Relations};
+use measure::Measurement;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Errors of `gaitfit calibrate`.
+#[derive(Debug, thiserror::Error)]
+pub enum CalibrateError {
+    /// Event detection or reading failed.
+    #[error(transparent)]
+    Events(#[from] EventError),
+    /// A generator refused its parameters.
+    #[error("{subject}: {message}")]
+    Generate {
+        /// The subject.
+        subject: String,
+        /// What failed.
+        message: String,
+    },
+    /// Nothing could be measured.
+    #[error("no input could be measured: {0}")]
+    NoInput(String),
+    /// Writing an output failed.
+    #[error("{path}: {message}")]
+    Write {
+        /// The file.
+        path: String,
+        /// What failed.
+        message: String,
+    },
+}
+
+/// Settings of a calibration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrateOptions {
+    /// Folder of fitted relations; `None` refits them on the inputs (into `refit_dir`).
+    pub fits: Option<PathBuf>,
+    /// Where the refitted relations are written when `fits` is `None`.
+    pub refit_dir: Option<PathBuf>,
+    /// Walk or run for every input, overriding the data.
+    pub gait: Option<Gait>,
+    /// Generated motions.
+    pub drive: DriveOptions,
+    /// Gauss–Newton iterations at most.
+    pub max_iters: u64,
+}
+
+impl Default for CalibrateOptions {
+    fn default() -> Self {
+        CalibrateOptions {
+            fits: None,
+            refit_dir: None,
+            gait: None,
+            drive: DriveOptions::default(),
+            max_iters: 8,
+        }
+    }
+}
+
+/// One measured condition (trial) of a subject.
+#[derive(Debug, Clone)]
+pub struct Condition {
+    /// Trial name.
+    pub trial: String,
+    /// Source file.
+    pub path: String,
+    /// The measurement.
+    pub measured: Measurement,
+    /// The measured step rows (for the refit).
+    pub rows: Vec<crate::ingest::trials::StepRow>,
+}
+
+impl Condition {
+    /// The measured speed (m/s).
+    pub fn speed(&self) -> f64 {
+        self.measured.quantities.speed_m_per_s
+    }
+}
+
+/// One subject × gait and its conditions.
+#[derive(Debug, Clone)]
+pub struct Subject {
+    /// Subject id.
+    pub name: String,
+    /// Walk or run.
+    pub gait: Gait,
+    /// Body height, m (from the data, or estimated; see `notes`).
+    pub body_height_m: f64,
+    /// Body mass, kg (0 when unknown).
+    pub mass_kg: f64,
+    /// The conditions, by speed.
+    pub conditions: Vec<Condition>,
+    /// What was assumed.
+    pub notes: Vec<String>,
+}
+
+/// Reads every input, detects events and steps, decides the gait from the data and groups
+/// the trials by subject and gait. Inputs that cannot be measured are reported in the second
+/// list (file: reason) and skipped.
+pub fn load_subjects(
+    inputs: &[PathBuf],
+    gait: Option<Gait>,
+) -> Result<(Vec<Subject>, Vec<String>), CalibrateError> {
+    let mut subjects: Vec<Subject> = Vec::new();
+    let mut failed = Vec::new();
+    for input in expand_inputs(inputs)? {
+        let label = input.label();
+        if input
+            .path
+            .file_stem()
+            .is_some_and(|s| s.to_string_lossy().eq_ignore_ascii_case("static"))
+        {
+            continue;
+        }
+        let mut trial = match read_input(&input, &ReadOptions::default()) {
+            Ok(t) => t,
+            Err(e) => {
+                failed.push(format!("{label}: {e}"));
+                continue;
+            }
+        };
+        let mut notes = Vec::new();
+        add_static_joint_centres(&mut trial, &input.path, &mut notes);
+        match measure_trial(&trial, gait) {
+            Ok((m, rows)) => {
+                let name = subject_label(&trial);
+                let (h, hn) = body_height(&trial);
+                notes.extend(hn);
+                let cond = Condition {
+                    trial: trial.name.clone(),
+                    path: trial.source.display().to_string(),
+                    measured: m,
+                    rows,
+                };
+                let g = cond.measured.gait;
+                match subjects.iter_mut().find(|s| s.name == name && s.gait == g) {
+                    Some(s) => {
+                        s.conditions.push(cond);
+                        s.notes.extend(notes);
+                    }
+                    None => subjects.push(Subject {
+                        name,
+                        gait: g,
+                        body_height_m: h,
+                        mass_kg: trial.subject.mass_kg.unwrap_or(0.0),
+                        conditions: vec![cond],
+                        notes,
+                    }),
+                }
+            }
+            Err(e) => failed.push(format!("{label}: {e}")),
+        }
+    }
+    for s in &mut subjects {
+        s.conditions.sort_by(|a, b| a.speed().total_cmp(&b.speed()));
+        s.notes.sort();
+        s.notes.dedup();
+    }
+    if subjects.is_empty() {
+        return Err(CalibrateError::NoInput(failed.join("; ")));
+    }
+    Ok((subjects, failed))
+}
+
+/// Adds joint centres carried from a `static.trc` beside a trial whose markers have only
+/// clusters (the Hamner runs), so that the hip/knee/ankle angles can be measured.
+fn add_static_joint_centres(trial: &mut Trial, path: &Path, notes: &mut Vec<String>) {
+    let st = path.with_file_name("static.trc");
+    let Some(markers) = trial.markers.as_mut() else {
+        return;
+    };
+    if markers.index("RKJC").is_some() || !st.is_file() {
+        return;
+    }
+    let opts = ReadOptions {
+        companions: false,
+        ..Default::default()
+    };
+    if let Ok(s) = crate::ingest::read_trial(&st, &opts) {
+        if let Some(sm) = &s.markers {
+            let added = measure::add_joint_centres(markers, sm);
+            if !added.is_empty() {
+                notes.push(format!(
+                    "joint centres {} carried from {} by their segment clusters (Kabsch)",
+                    added.join(", "),
+                    st.display()
+                ));
+            }
+        }
+    }
+}
+
+/// Body height from the trial, else from the leg length (Bruderlin & Calvert 1989 Table B-1,
+/// thigh + shank = 0.48225 h, with the hip height ≈ leg + 0.039 h ankle height), else 1.75 m.
+fn body_height(trial: &Trial) -> (f64, Vec<String>) {
+    if let Some(h) = trial.subject.body_height_m.filter(|h| *h > 0.5) {
+        return (h, Vec::new());
+    }
+    if let Some(l) = trial.subject.leg_length_m.filter(|l| *l > 0.3) {
+        let h = l / 0.53;
+        return (
+            h,
+            vec![format!(
+                "body height not in the data: {h:.3} m from the leg length {l:.3} m (leg ≈ 0.53 h)"
+            )],
+        );
+    }
+    (
+        1.75,
+        vec!["body height not in the data: 1.75 m assumed".to_string()],
+    )
+}
+
+/// Decides the gait (unless given) and measures a measured trial over all its steps.
+pub fn measure_trial(
+    trial: &Trial,
+    gait: Option<Gait>,
+) -> Result<(Measurement, Vec<crate::ingest::trials::StepRow>), EventError> {
+    let (g, evidence) = match gait {
+        Some(g) => (g, format!("{g}: given with --gait")),
+        None => measure::gait_from_data(trial)?,
+    };
+    let opts = measure::event_options(trial, g, None);
+    let m = measure::measure(
+        trial,
+        g,
+        evidence,
+        &opts,
+        (f64::NEG_INFINITY, f64::INFINITY),
+    )?;
+    let rows = crate::events::steps_from_trial(trial, &opts)
+        .map(|t| t.rows)
+        .unwrap_or_default();
+    Ok((m, rows))
+}
+
+/// Measures a generated motion with the same pipeline (gait known, noise-free data: a
+/// 0.2·fps marker filter and a 1 mm foot-height tolerance).
+pub fn measure_generated(d: &drive::Driven, gait: Gait) -> Result<Measurement, EventError> {
+    let trial = d.motion.to_trial("generated");
+    let fps = d.motion.fps();
+    let opts = measure::event_options(&trial, gait, Some((0.2 * fps, 1e-3)));
+    measure::measure(&trial, gait, format!("{gait}: generated"), &opts, d.window)
+}
+
+/// The relations to drive the generators with: `--fits DIR`, or refitted on the measured
+/// steps (written to `refit_dir`), each relation that cannot be fitted falling back to the
+/// published one (with a note).
+pub fn relations(
+    opts: &CalibrateOptions,
+    subjects: &[Subject],
+) -> Result<(Relations, Vec<String>), CalibrateError> {
+    use crate::generator::running::equations::RunRelations;
+    use crate::generator::walking::WalkRelations;
+    let gen = |e: crate::generator::GenerateError| CalibrateError::Generate {
+        subject: "relations".into(),
+        message: e.to_string(),
+    };
+    if let Some(dir) = &opts.fits {
+        let has_run = subjects.iter().any(|s| s.gait == Gait::Run);
+        let has_walk = subjects.iter().any(|s| s.gait == Gait::Walk);
+        let run = if has_run {
+            RunRelations::from_fits(dir).map_err(gen)?
+        } else {
+            RunRelations::published()
+        };
+        let walk = if has_walk {
+            WalkRelations::from_fits_dir(dir).map_err(gen)?
+        } else {
+            WalkRelations::published()
+        };
+        return Ok((
+            Relations {
+                run,
+                walk,
+                source: dir.display().to_string(),
+            },
+            Vec::new(),
+        ));
+    }
+    let mut notes = Vec::new();
+    let rows: Vec<_> = subjects
+        .iter()
+        .flat_map(|s| s.conditions.iter().flat_map(|c| c.rows.iter().cloned()))
+        .collect();
+    let table = crate::ingest::trials::TrialsTable::from_step_rows("calibrate inputs", &rows);
+    let dir = opts
+        .refit_dir
+        .clone()
+        .unwrap_or_else(|| std::env::temp_dir().join("gaitfit-calibrate-fits"));
+    std::fs::create_dir_all(&dir).map_err(|e| CalibrateError::Write {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let rels: Vec<_> = crate::relations::registry()
+        .into_iter()
+        .filter(|r| r.id() != "kb-mu")
+        .collect();
+    let run = crate::fit::pipeline::fit_all(
+        &rels,
+        std::slice::from_ref(&table),
+        &crate::fit::pipeline::FitOptions::default(),
+        true,
+        |_| {},
+    );
+    for o in &run.outcomes {
+        crate::export::coeffs::write_fit_files(&dir, &o.record).map_err(|e| {
+            CalibrateError::Write {
+                path: dir.display().to_string(),
+                message: e.to_string(),
+            }
+        })?;
+        notes.push(format!("refitted {} on the inputs", o.record.relation));
+    }
+    for (id, why) in run.failures.iter().chain(&run.skipped) {
+        notes.push(format!("{id} not refitted ({why}): published coefficients"));
+    }
+    let run_rel = RunRelations::from_fits(&dir).unwrap_or_else(|_| RunRelations::published());
+    let walk_rel =
+        WalkRelations::from_fits_dir(&dir).unwrap_or_else(|_| WalkRelations::published());
+    Ok((
+        Relations {
+            run: run_rel,
+            walk: walk_rel,
+            source: format!("refitted on the inputs ({})", dir.display()),
+        },
+        notes,
+    ))
+}
+
+/// A subject's two stages and its calibration.
+#[derive(Debug, Clone)]
+pub struct SubjectResult {
+    /// The subject.
+    pub subject: Subject,
+    /// Stage `relations`: the attributes before calibration and the generated measurements.
+    pub before: solve::Stage,
+    /// Stage `calibrated`.
+    pub after: solve::Stage,
+    /// Standard errors of the calibrated attributes (Gauss–Newton covariance).
+    pub se: [Option<f64>; 3],
+    /// Gauss–Newton iterations and objective evaluations.
+    pub iterations: u64,
+    /// Objective evaluations.
+    pub evaluations: usize,
+}
+
+/// Everything one `calibrate` run found.
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// Per subject.
+    pub subjects: Vec<SubjectResult>,
+    /// Where the relations came from.
+    pub relations_source: String,
+    /// Notes of the relations (refit).
+    pub relation_notes: Vec<String>,
+    /// Inputs that could not be measured.
+    pub failed: Vec<String>,
+    /// The generated motions' settings.
+    pub drive: DriveOptions,
+}
+
+/// Calibrates every subject (`progress` is called with each subject's one-line summary).
+pub fn calibrate(
+    inputs: &[PathBuf],
+    opts: &CalibrateOptions,
+    mut progress: impl FnMut(usize, usize, &SubjectResult),
+) -> Result<Calibration, CalibrateError> {
+    let (subjects, failed) = load_subjects(inputs, opts.gait)?;
+    let (rel, relation_notes) = relations(opts, &subjects)?;
+    let n = subjects.len();
+    let mut out = Vec::new();
+    for (i, s) in subjects.into_iter().enumerate() {
+        let r = solve::calibrate_subject(s, &rel, opts)?;
+        progress(i + 1, n, &r);
+        out.push(r);
+    }
+    Ok(Calibration {
+        subjects: out,
+        relations_source: rel.source.clone(),
+        relation_notes,
+        failed,
+        drive: opts.drive,
+    })
+}
+
+/// One subject's calibration as stored in `calibrated.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibratedSubject {
+    /// Subject id.
+    pub subject: String,
+    /// walk or run.
+    pub gait: Gait,
+    /// Body height, m.
+    pub body_height_m: f64,
+    /// Body mass, kg (0 when unknown).
+    pub mass_kg: f64,
+    /// Measured speeds, m/s.
+    pub speeds_m_per_s: Vec<f64>,
+    /// The attributes.
+    pub attributes: Vec<CalibratedAttr>,
+}
+
+/// One calibrated attribute.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibratedAttr {
+    /// Name (see [`drive::RUN_ATTRS`], [`drive::WALK_ATTRS`]).
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Before calibration.
+    pub before: f64,
+    /// After calibration.
+    pub value: f64,
+    /// Standard error (Gauss–Newton), when identifiable.
+    pub se: Option<f64>,
+}
+
+/// `calibrated.json`: what `gaitfit generate run|walk --calibration FILE` reuses.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibratedFile {
+    /// Format tag.
+    pub format: String,
+    /// Where the relations came from (`--fits DIR` or the refit folder).
+    pub relations: String,
+    /// Per subject.
+    pub subjects: Vec<CalibratedSubject>,
+}
+
+impl CalibratedFile {
+    /// The format tag.
+    pub const FORMAT: &'static str = "gaitfit-calibration-1";
+
+    /// Reads a calibrated.json.
+    pub fn read(path: &Path) -> Result<CalibratedFile, CalibrateError> {
+        let text = std::fs::read_to_string(path).map_err(|e| CalibrateError::Write {
+            path: path.display().to_string(),
+            message: format!("cannot read: {e}"),
+        })?;
+        let f: CalibratedFile = serde_json::from_str(&text).map_err(|e| CalibrateError::Write {
+            path: path.display().to_string(),
+            message: format!("not a calibrated.json: {e}"),
+        })?;
+        if f.format != Self::FORMAT {
+            return Err(CalibrateError::Write {
+                path: path.display().to_string(),
+                message: format!("format {:?}, expected {:?}", f.format, Self::FORMAT),
+            });
+        }
+        Ok(f)
+    }
+
+    /// The entry of `gait` for `subject` (or the only entry of that gait).
+    pub fn pick(&self, gait: Gait, subject: Option<&str>) -> Result<&CalibratedSubject, String> {
+        let of_gait: Vec<_> = self.subjects.iter().filter(|s| s.gait == gait).collect();
+        match subject {
+            Some(name) => of_gait
+                .iter()
+                .find(|s| s.subject == name)
+                .copied()
+                .ok_or_else(|| format!("no {gait} calibration for subject {name:?}")),
+            None if of_gait.len() == 1 => Ok(of_gait[0]),
+            None if of_gait.is_empty() => Err(format!("no {gait} calibration in the file")),
+            None => Err(format!(
+                "{} {gait} calibrations ({}): choose one with --subject",
+                of_gait.len(),
+                of_gait
+                    .iter()
+                    .map(|s| s.subject.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+
+    /// The attribute vector of an entry, in the order of [`drive::attr_defs`].
+    pub fn theta(s: &CalibratedSubject) -> Result<[f64; 3], String> {
+        let defs = drive::attr_defs(s.gait);
+        let mut out = [0.0; 3];
+        for (o, d) in out.iter_mut().zip(defs.iter()) {
+            *o = s
+                .attributes
+                .iter()
+                .find(|a| a.name == d.name)
+                .map(|a| a.value)
+                .ok_or_else(|| format!("attribute {} missing", d.name))?;
+        }
+        Ok(out)
+    }
+}
+
+/// The one-line summary of a subject: gait, conditions, and the mean |residual| of cadence,
+/// step length and flight/double support before → after calibration.
+pub fn summary_line(r: &SubjectResult) -> String {
+    let s = &r.subject;
+    let mean_abs = |st: &solve::Stage, q: usize| {
+        let v: Vec<f64> = s
+            .conditions
+            .iter()
+            .zip(&st.generated)
+            .filter_map(|(c, g)| {
+                let g = g.as_ref().ok()?;
+                Some((solve::value(g, q)? - solve::value(&c.measured, q)?).abs())
+            })
+            .collect();
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
+    };
+    let (pname, pscale, punit) = match s.gait {
+        Gait::Run => ("flight", 1000.0, "ms"),
+        Gait::Walk => ("double support", 1.0, "% cycle"),
+    };
+    format!(
+        "{} ({}, {} condition(s), {:.2}–{:.2} m/s): |Δcadence| {:.1} → {:.1} steps/min, \
+         |Δstep length| {:.1} → {:.1} cm, |Δ{pname}| {:.1} → {:.1} {punit}",
+        s.name,
+        s.gait,
+        s.conditions.len(),
+        s.conditions.first().map_or(0.0, |c| c.speed()),
+        s.conditions.last().map_or(0.0, |c| c.speed()),
+        mean_abs(&r.before, 0),
+        mean_abs(&r.after, 0),
+        100.0 * mean_abs(&r.before, 1),
+        100.0 * mean_abs(&r.after, 1),
+        pscale * mean_abs(&r.before, 3),
+        pscale * mean_abs(&r.after, 3),
+    )
+}

@@ -1,0 +1,456 @@
+//! The outputs of `gaitfit calibrate`: `residuals.csv`, `calibrated.json` and `report.html`
+//! (one self-contained file, inline SVG, nothing from the network).
+use super::drive::attr_defs;
+use super::measure::{rms_corr, Curves, Measurement, CYCLE_POINTS};
+use super::solve::{value, Stage};
+use super::{CalibrateError, CalibratedAttr, CalibratedFile, CalibratedSubject, Calibration};
+use crate::events::Gait;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// One row of `residuals.csv`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResidualRow {
+    /// Subject id.
+    pub subject: String,
+    /// walk or run.
+    pub gait: Gait,
+    /// Measured speed, m/s.
+    pub speed_m_per_s: f64,
+    /// Quantity name.
+    pub quantity: String,
+    /// Unit.
+    pub unit: String,
+    /// Measured value.
+    pub measured: f64,
+    /// Generated value (NaN when the generated motion does not show it).
+    pub generated: f64,
+    /// generated − measured.
+    pub residual: f64,
+    /// relations | calibrated.
+    pub stage: &'static str,
+}
+
+fn scalar_quantities(gait: Gait) -> [(&'static str, &'static str, f64); 5] {
+    [
+        ("cadence_steps_per_min", "steps/min", 1.0),
+        ("step_length_m", "m", 1.0),
+        ("contact_time_s", "s", 1.0),
+        match gait {
+            Gait::Run => ("flight_time_s", "s", 1.0),
+            Gait::Walk => ("double_support_pct_cycle", "% cycle", 1.0),
+        },
+        ("pelvis_excursion_m", "m", 1.0),
+    ]
+}
+
+/// The residual rows of every subject, condition, quantity and stage (angle RMS rows where
+/// both sides have curves: measured = 0, generated = residual = the RMS difference).
+pub fn residual_rows(cal: &Calibration) -> Vec<ResidualRow> {
+    let mut out = Vec::new();
+    for r in &cal.subjects {
+        let s = &r.subject;
+        for (stage_name, stage) in [("relations", &r.before), ("calibrated", &r.after)] {
+            for (c, cond) in s.conditions.iter().enumerate() {
+                let m = &cond.measured;
+                let g = stage.generated[c].as_ref().ok();
+                for (q, (name, unit, _)) in scalar_quantities(s.gait).iter().enumerate() {
+                    let Some(mv) = value(m, q) else { continue };
+                    let gv = g.and_then(|g| value(g, q)).unwrap_or(f64::NAN);
+                    out.push(ResidualRow {
+                        subject: s.name.clone(),
+                        gait: s.gait,
+                        speed_m_per_s: cond.speed(),
+                        quantity: name.to_string(),
+                        unit: unit.to_string(),
+                        measured: mv,
+                        generated: gv,
+                        residual: gv - mv,
+                        stage: stage_name,
+                    });
+                }
+                if let (Some(mc), Some(gc)) = (&m.curves, g.and_then(|g| g.curves.as_ref())) {
+                    for (name, a, b) in curve_pairs(mc, gc) {
+                        let (rms, _) = rms_corr(a, b);
+                        out.push(ResidualRow {
+                            subject: s.name.clone(),
+                            gait: s.gait,
+                            speed_m_per_s: cond.speed(),
+                            quantity: format!("{name}_rms_deg"),
+                            unit: "deg".into(),
+                            measured: 0.0,
+                            generated: rms,
+                            residual: rms,
+                            stage: stage_name,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn curve_pairs<'a>(m: &'a Curves, g: &'a Curves) -> [(&'static str, &'a [f64], &'a [f64]); 3] {
+    [
+        ("hip_flexion", &m.hip_deg, &g.hip_deg),
+        ("knee_flexion", &m.knee_deg, &g.knee_deg),
+        ("ankle_dorsiflexion", &m.ankle_deg, &g.ankle_deg),
+    ]
+}
+
+fn werr(path: &Path, e: impl std::fmt::Display) -> CalibrateError {
+    CalibrateError::Write {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    }
+}
+
+/// Writes `residuals.csv` (columns subject, gait, speed_m_per_s, quantity, unit, measured,
+/// generated, residual, stage).
+pub fn write_residuals(path: &Path, rows: &[ResidualRow]) -> Result<(), CalibrateError> {
+    let mut s = String::from(
+        "subject,gait,speed_m_per_s,quantity,unit,measured,generated,residual,stage\n",
+    );
+    let num = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.6}")
+        } else {
+            String::new()
+        }
+    };
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{},{:.4},{},{},{},{},{},{}",
+            r.subject,
+            r.gait,
+            r.speed_m_per_s,
+            r.quantity,
+            r.unit,
+            num(r.measured),
+            num(r.generated),
+            num(r.residual),
+            r.stage
+        );
+    }
+    crate::fsio::write_atomic_bytes(path, s.as_bytes()).map_err(|e| werr(path, e))
+}
+
+/// The content of `calibrated.json`.
+pub fn calibrated_file(cal: &Calibration) -> CalibratedFile {
+    CalibratedFile {
+        format: CalibratedFile::FORMAT.into(),
+        relations: cal.relations_source.clone(),
+        subjects: cal
+            .subjects
+            .iter()
+            .map(|r| CalibratedSubject {
+                subject: r.subject.name.clone(),
+                gait: r.subject.gait,
+                body_height_m: r.subject.body_height_m,
+                mass_kg: r.subject.mass_kg,
+                speeds_m_per_s: r.subject.conditions.iter().map(|c| c.speed()).collect(),
+                attributes: attr_defs(r.subject.gait)
+                    .iter()
+                    .enumerate()
+                    .map(|(i, d)| CalibratedAttr {
+                        name: d.name.into(),
+                        unit: d.unit.into(),
+                        before: r.before.theta[i],
+                        value: r.after.theta[i],
+                        se: r.se[i],
+                    })
+                    .collect(),
+            })
+            .collect(),
+    }
+}
+
+/// Writes `calibrated.json`.
+pub fn write_calibrated(path: &Path, cal: &Calibration) -> Result<(), CalibrateError> {
+    let json = serde_json::to_string_pretty(&calibrated_file(cal)).map_err(|e| werr(path, e))?;
+    crate::fsio::write_atomic_bytes(path, json.as_bytes()).map_err(|e| werr(path, e))
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// An inline SVG of curves over the normalised cycle: (label, colour, dashed, values).
+fn curve_svg(title: &str, series: &[(&str, &str, bool, &[f64])]) -> String {
+    let (w, h, ml, mr, mt, mb) = (360.0, 220.0, 44.0, 10.0, 24.0, 30.0);
+    let all: Vec<f64> = series
+        .iter()
+        .flat_map(|s| s.3.iter().copied())
+        .filter(|v| v.is_finite())
+        .collect();
+    let (mut lo, mut hi) = all
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    if !(lo.is_finite() && hi.is_finite()) {
+        lo = 0.0;
+        hi = 1.0;
+    }
+    if hi - lo < 1e-9 {
+        hi = lo + 1.0;
+    }
+    let pad = 0.05 * (hi - lo);
+    let (lo, hi) = (lo - pad, hi + pad);
+    let x = |i: usize| ml + (w - ml - mr) * i as f64 / (CYCLE_POINTS - 1) as f64;
+    let y = |v: f64| mt + (h - mt - mb) * (1.0 - (v - lo) / (hi - lo));
+    let mut s = format!(
+        "<svg class=\"fig\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"{t}\">\
+         <text x=\"{ml}\" y=\"15\" font-size=\"12\">{t}</text>\
+         <rect x=\"{ml}\" y=\"{mt}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"#999\"/>",
+        t = esc(title),
+        pw = w - ml - mr,
+        ph = h - mt - mb
+    );
+    for k in 0..=4 {
+        let v = lo + (hi - lo) * k as f64 / 4.0;
+        let _ = write!(
+            s,
+            "<text x=\"{}\" y=\"{:.1}\" font-size=\"9\" text-anchor=\"end\">{v:.0}</text>",
+            ml - 3.0,
+            y(v) + 3.0
+        );
+    }
+    for k in 0..=4 {
+        let i = k * 25;
+        let _ = write!(
+            s,
+            "<text x=\"{:.1}\" y=\"{}\" font-size=\"9\" text-anchor=\"middle\">{i} %</text>",
+            x(i),
+            h - mb + 12.0
+        );
+    }
+    for (n, (label, colour, dashed, v)) in series.iter().enumerate() {
+        let pts: Vec<String> = v
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .map(|(i, v)| format!("{:.1},{:.1}", x(i), y(*v)))
+            .collect();
+        let _ = write!(
+            s,
+            "<polyline class=\"series\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.6\"{} points=\"{}\"/>",
+            if *dashed { " stroke-dasharray=\"5,3\"" } else { "" },
+            pts.join(" ")
+        );
+        let ly = h - 6.0;
+        let lx = ml + 110.0 * n as f64;
+        let _ = write!(
+            s,
+            "<line x1=\"{lx}\" y1=\"{ly}\" x2=\"{}\" y2=\"{ly}\" stroke=\"{colour}\"{}/>\
+             <text x=\"{}\" y=\"{}\" font-size=\"9\">{}</text>",
+            lx + 14.0,
+            if *dashed {
+                " stroke-dasharray=\"5,3\""
+            } else {
+                ""
+            },
+            lx + 17.0,
+            ly + 3.0,
+            esc(label)
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+fn fmt(v: Option<f64>, d: usize) -> String {
+    match v {
+        Some(v) if v.is_finite() => format!("{v:.d$}"),
+        _ => "—".into(),
+    }
+}
+
+fn stage_cell(g: &Result<Measurement, String>, q: usize, d: usize, m: Option<f64>) -> String {
+    match g {
+        Ok(g) => {
+            let v = value(g, q);
+            match (v, m) {
+                (Some(v), Some(m)) => format!("{v:.d$} ({:+.d$})", v - m),
+                (v, _) => fmt(v, d),
+            }
+        }
+        Err(e) => format!("<span title=\"{}\">failed</span>", esc(e)),
+    }
+}
+
+/// Writes `report.html`.
+pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError> {
+    let mut h = String::from(
+        "<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>gaitfit calibrate</title><style>\
+         body{font-family:sans-serif;margin:1.5em;max-width:1200px}\
+         table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;padding:2px 6px;\
+         font-size:13px;text-align:right}th{background:#eee}td:first-child{text-align:left}\
+         .figs{display:flex;flex-wrap:wrap;gap:8px}.note{color:#555;font-size:12px}\
+         </style></head><body>",
+    );
+    let _ = write!(
+        h,
+        "<h1>gaitfit calibrate</h1><p>Relations: {}. Generated motions at {} frames/s, {} steady \
+         steps per condition, measured by the same event pipeline as the trials. Residual = \
+         generated − measured; stage <i>relations</i>: the relations with the generators' default \
+         attributes; stage <i>calibrated</i>: the per-subject attributes found by Gauss–Newton on \
+         the weighted residual objective (weights: the measured step-to-step SD).</p>",
+        esc(&cal.relations_source),
+        cal.drive.fps,
+        cal.drive.steps
+    );
+    for n in &cal.relation_notes {
+        let _ = write!(h, "<p class=\"note\">{}</p>", esc(n));
+    }
+    for f in &cal.failed {
+        let _ = write!(h, "<p class=\"note\">not measured: {}</p>", esc(f));
+    }
+    for r in &cal.subjects {
+        let s = &r.subject;
+        let _ = write!(
+            h,
+            "<section><h2>{} — {}</h2><p>Body height {:.3} m{}; {} condition(s); objective {:.2} → {:.2} \
+             ({} Gauss–Newton iteration(s)).</p>",
+            esc(&s.name),
+            s.gait,
+            s.body_height_m,
+            if s.mass_kg > 0.0 {
+                format!(", mass {:.1} kg", s.mass_kg)
+            } else {
+                String::new()
+            },
+            s.conditions.len(),
+            r.before.cost,
+            r.after.cost,
+            r.iterations
+        );
+        for n in &s.notes {
+            let _ = write!(h, "<p class=\"note\">{}</p>", esc(n));
+        }
+        // Attributes.
+        h.push_str("<table><tr><th>attribute</th><th>unit</th><th>before</th><th>after</th><th>± SE</th><th>meaning</th></tr>");
+        for (i, d) in attr_defs(s.gait).iter().enumerate() {
+            let _ = write!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
+                d.name,
+                esc(d.unit),
+                r.before.theta[i],
+                r.after.theta[i],
+                fmt(r.se[i], 4),
+                esc(d.doc)
+            );
+        }
+        h.push_str("</table>");
+        // Residual table.
+        h.push_str("<table><tr><th>trial</th><th>speed m/s</th><th>quantity</th><th>measured</th><th>relations (resid.)</th><th>calibrated (resid.)</th></tr>");
+        for (c, cond) in s.conditions.iter().enumerate() {
+            let m = &cond.measured;
+            for (q, (name, unit, _)) in scalar_quantities(s.gait).iter().enumerate() {
+                let mv = value(m, q);
+                if mv.is_none() {
+                    continue;
+                }
+                let d = if unit == &"m" || unit == &"s" { 3 } else { 1 };
+                let _ = write!(
+                    h,
+                    "<tr><td>{}</td><td>{:.2}</td><td>{} [{}]</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    esc(&cond.trial),
+                    cond.speed(),
+                    name,
+                    esc(unit),
+                    fmt(mv, d),
+                    stage_cell(&r.before.generated[c], q, d, mv),
+                    stage_cell(&r.after.generated[c], q, d, mv)
+                );
+            }
+            if let Some(mc) = &m.curves {
+                for (k, name) in ["hip_flexion", "knee_flexion", "ankle_dorsiflexion"]
+                    .iter()
+                    .enumerate()
+                {
+                    let cell = |st: &Stage| match st.generated[c]
+                        .as_ref()
+                        .ok()
+                        .and_then(|g| g.curves.as_ref())
+                    {
+                        Some(gc) => {
+                            let p = curve_pairs(mc, gc);
+                            let (rms, cor) = rms_corr(p[k].1, p[k].2);
+                            format!("RMS {rms:.1}°, r {cor:.2}")
+                        }
+                        None => "—".into(),
+                    };
+                    let _ = write!(
+                        h,
+                        "<tr><td>{}</td><td>{:.2}</td><td>{} curve</td><td>{} strides</td><td>{}</td><td>{}</td></tr>",
+                        esc(&cond.trial),
+                        cond.speed(),
+                        name,
+                        mc.strides,
+                        cell(&r.before),
+                        cell(&r.after)
+                    );
+                }
+            }
+        }
+        h.push_str("</table><div class=\"figs\">");
+        for (c, cond) in s.conditions.iter().enumerate() {
+            let Some(mc) = &cond.measured.curves else {
+                continue;
+            };
+            let gb = r.before.generated[c]
+                .as_ref()
+                .ok()
+                .and_then(|g| g.curves.as_ref());
+            let ga = r.after.generated[c]
+                .as_ref()
+                .ok()
+                .and_then(|g| g.curves.as_ref());
+            for k in 0..3 {
+                let mut series: Vec<(&str, &str, bool, &[f64])> =
+                    vec![("measured", "#000", false, curve_pairs(mc, mc)[k].1)];
+                if let Some(g) = gb {
+                    series.push(("relations", "#1f77b4", true, curve_pairs(g, g)[k].1));
+                }
+                if let Some(g) = ga {
+                    series.push(("calibrated", "#d62728", false, curve_pairs(g, g)[k].1));
+                }
+                let title = format!(
+                    "{} {:.2} m/s: {} (deg)",
+                    cond.trial,
+                    cond.speed(),
+                    ["hip (thigh)", "knee flexion", "ankle dorsiflexion"][k]
+                );
+                h.push_str(&curve_svg(&title, &series));
+            }
+        }
+        h.push_str("</div>");
+        let mut gen_notes = r.after.notes.clone();
+        gen_notes.extend(r.before.notes.iter().cloned());
+        gen_notes.sort();
+        gen_notes.dedup();
+        for n in gen_notes.iter().take(8) {
+            let _ = write!(h, "<p class=\"note\">generator: {}</p>", esc(n));
+        }
+        h.push_str("</section>");
+    }
+    h.push_str("<p class=\"note\">Data: cite the sources of the inputs (see ../shared/data/README.md).</p></body></html>\n");
+    crate::fsio::write_atomic_bytes(path, h.as_bytes()).map_err(|e| werr(path, e))
+}
+
+/// Writes `residuals.csv`, `calibrated.json` and `report.html` into `dir`.
+pub fn write_all(dir: &Path, cal: &Calibration) -> Result<(), CalibrateError> {
+    std::fs::create_dir_all(dir).map_err(|e| werr(dir, e))?;
+    write_residuals(&dir.join("residuals.csv"), &residual_rows(cal))?;
+    write_calibrated(&dir.join("calibrated.json"), cal)?;
+    write_report(&dir.join("report.html"), cal)
+}

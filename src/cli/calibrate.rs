@@ -1,0 +1,93 @@
+//! `gaitfit calibrate`: the closing loop as a command (library: [`crate::calibrate`]).
+use crate::calibrate::{calibrate, output, CalibrateOptions};
+use crate::events::Gait;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Arguments of `gaitfit calibrate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Measured trials: files or folders (TRC + GRF, C3D, MOT, WBDS, gaitfit CSV).
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Folder of fitted relations (`gaitfit fit`); without it the relations are refitted on the
+    /// inputs (into DIR/fits).
+    #[arg(long)]
+    pub fits: Option<PathBuf>,
+    /// Walk or run for every input (default: decided from the data: flight phases or double
+    /// support).
+    #[arg(long, value_parser = parse_gait)]
+    pub gait: Option<Gait>,
+    /// Output folder: report.html, residuals.csv, calibrated.json.
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+    /// Frames per second of the generated motions.
+    #[arg(long, default_value_t = 200.0)]
+    pub fps: f64,
+    /// Steady steps generated per condition.
+    #[arg(long, default_value_t = 12)]
+    pub steps: usize,
+    /// Gauss–Newton iterations at most.
+    #[arg(long, default_value_t = 8)]
+    pub max_iters: u64,
+}
+
+fn parse_gait(s: &str) -> Result<Gait, String> {
+    Gait::parse(s).ok_or_else(|| format!("{s:?}: use walk or run"))
+}
+
+/// Runs `gaitfit calibrate`.
+pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
+    if !(args.fps.is_finite() && (50.0..=2000.0).contains(&args.fps)) {
+        anyhow::bail!("--fps {}: use 50 to 2000 frames/s", args.fps);
+    }
+    if args.steps < 4 {
+        anyhow::bail!("--steps {}: at least 4 steady steps", args.steps);
+    }
+    let opts = CalibrateOptions {
+        fits: args.fits.clone(),
+        refit_dir: Some(args.out.join("fits")),
+        gait: args.gait,
+        drive: crate::calibrate::drive::DriveOptions {
+            fps: args.fps,
+            steps: args.steps,
+        },
+        max_iters: args.max_iters,
+    };
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new_spinner();
+        if let Ok(style) =
+            indicatif::ProgressStyle::with_template("{spinner} {pos}/{len} subjects {msg}")
+        {
+            b.set_style(style);
+        }
+        b.set_message("measuring the inputs");
+        b.enable_steady_tick(std::time::Duration::from_millis(200));
+        b
+    });
+    let cal = calibrate(&args.inputs, &opts, |i, n, r| {
+        let line = crate::calibrate::summary_line(r);
+        match &bar {
+            Some(b) => {
+                b.set_length(n as u64);
+                b.set_position(i as u64);
+                b.println(line);
+            }
+            None => eprintln!("{line}"),
+        }
+    })?;
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    for f in &cal.failed {
+        eprintln!("gaitfit: warning: not measured: {f}");
+    }
+    output::write_all(&args.out, &cal)?;
+    println!(
+        "gaitfit calibrate: {} subject(s) → {}/report.html, residuals.csv, calibrated.json",
+        cal.subjects.len(),
+        args.out.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}
