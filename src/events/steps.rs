@@ -7,7 +7,12 @@
 //!   toe off), swing of A (its toe off to its next heel strike);
 //! - walking (B lands before A lifts): double support `t_ds` = B's toe off after A's heel strike
 //!   − `t_A` (walking paper §3: a step is the double support state followed by the single
-//!   support state), and `t_ds / t_cycle · 100` with `t_cycle = 2 / sf` as in §3;
+//!   support state), and `t_ds / t_cycle · 100` with `t_cycle = 2 / sf` as in §3. It is one
+//!   period per step (the initial double support of A, which is the terminal one of B), so the
+//!   mean over steps is the mean over periods; a step whose period is unknown (no toe off of B
+//!   between the two heel strikes) has none. With force events the toe off is where the foot's
+//!   unloading tail crosses 20 N, across the zeroed samples some exports leave inside it
+//!   (`tools/events/force_truth.py` shows they hide load);
 //! - running (A lifts before B lands): flight time `t_B − toe off of A`, and the flight height
 //!   H of the running paper's eq. 3 from the pelvis height at A's toe off (`y1`) and B's heel
 //!   strike (`y2`): `H = (t_flight − 2(y1 − y2)/(g·t_flight))² · g/8`. H is the apex of the
