@@ -46,9 +46,12 @@ pub struct Args {
     #[arg(short, long)]
     pub verbose: bool,
     /// Which events build the steps: auto (force with per-foot plates, else the file's own
-    /// events, else the plates if they saw two steps, else foot-speed for walks and Zeni for
-    /// runs), force, zeni, zeni-velocity, foot-height, foot-speed (walks: Zeni windows refined
-    /// by the heel and toe speed over the ground, Bonci et al. 2022), reference.
+    /// events, else the plates if they saw two steps, else the markers' method for the gait),
+    /// force, kinematic (markers alone, the method for the trial's gait told from the data:
+    /// foot-speed for walks, foot-jerk for runs), foot-speed (walks: Zeni windows refined by
+    /// the heel and toe speed over the ground, Bonci et al. 2022), foot-jerk (runs: heel or
+    /// metatarsal impact jerk at touchdown, toe speed over the ground at toe off), zeni,
+    /// zeni-velocity, foot-height, reference.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
     pub events: String,
     /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
@@ -101,8 +104,8 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     read.belt_speed_m_per_s = args.belt_speed;
     opts.primary = PrimarySource::parse(&args.events).with_context(|| {
         format!(
-            "--events {}: use auto, force, zeni, zeni-velocity, foot-height, foot-speed or \
-             reference",
+            "--events {}: use auto, force, kinematic, foot-speed, foot-jerk, zeni, \
+             zeni-velocity, foot-height or reference",
             args.events
         )
     })?;
@@ -334,9 +337,11 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     if args.summary {
         print!("{}", summary(&ok));
     }
-    if args.verbose {
-        for r in &ok {
-            for n in &r.notes {
+    // Warnings (an estimated body height, a header that over-counts its frames, …) always go
+    // to stderr; the other notes with -v.
+    for r in &ok {
+        for n in &r.notes {
+            if args.verbose || n.starts_with("warning:") {
                 eprintln!("{}: {n}", r.label);
             }
         }

@@ -223,7 +223,7 @@ pub fn steps_from_analysis(
         if let Some(l) = leg_length {
             body_height = Some(l / LEG_LENGTH_PER_BODY_HEIGHT);
             table.notes.push(format!(
-                "body height {:.3} m estimated from the leg length {l:.3} m as leg / {} \
+                "warning: body height {:.3} m estimated from the leg length {l:.3} m as leg / {} \
                  (Winter 2009, Fig. 4.1)",
                 l / LEG_LENGTH_PER_BODY_HEIGHT,
                 LEG_LENGTH_PER_BODY_HEIGHT

@@ -1,6 +1,8 @@
 //! The Hamner & Delp (2013) running data set as laid out in `../shared/data/hamner2013/`:
 //! `subjectNN/Run_V_grf.mot`, `subjectNN/Run_V.trc`, `subjectNN/static.trc`, and a `README.md`
-//! one level up listing each runner's body mass.
+//! one level up listing each runner's body mass; or OpenSim's distribution of it,
+//! `subjectNN/expData/FILE` (no README: the subject id from the folder names, `static.trc` in
+//! the subject folder or beside the file).
 //!
 //! What the files do not say and this module supplies (each with a note):
 //! - the belt speed, from the file name (`Run_3` → 3 m/s; treadmill running);
@@ -34,17 +36,29 @@ pub fn belt_speed_from_name(name: &str) -> Option<f64> {
     digits.parse::<f64>().ok().filter(|v| *v > 0.0)
 }
 
-/// The Hamner subject folder of `path` (`…/subject01/…`) and the data set's README, when `path`
-/// lies in that layout.
-fn layout(path: &Path) -> Option<(String, std::path::PathBuf)> {
+/// The Hamner subject folder of `path` and the data set's README (`None` when there is none),
+/// when `path` lies in one of the data set's layouts: `…/subjectNN/FILE` with a README one level
+/// up that names Hamner (the shared data), or OpenSim's distribution `…/subjectNN/expData/FILE`
+/// (recognised by the folder names alone; `ExpData` in any case).
+fn layout(path: &Path) -> Option<(String, Option<std::path::PathBuf>)> {
     let dir = path.parent()?;
-    let subject = dir.file_name()?.to_string_lossy().into_owned();
-    if !(subject.starts_with("subject") && subject[7..].chars().all(|c| c.is_ascii_digit())) {
+    let exp = dir
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().eq_ignore_ascii_case("expdata"));
+    let subject_dir = if exp { dir.parent()? } else { dir };
+    let subject = subject_dir.file_name()?.to_string_lossy().into_owned();
+    let digits = subject.strip_prefix("subject")?;
+    if digits.is_empty() || !digits.chars().all(|c| c.is_ascii_digit()) {
         return None;
     }
-    let readme = dir.parent()?.join("README.md");
-    let text = std::fs::read_to_string(&readme).ok()?;
-    text.contains("Hamner").then_some((subject, readme))
+    let readme = subject_dir.parent().map(|p| p.join("README.md"));
+    let hamner_readme =
+        readme.filter(|r| std::fs::read_to_string(r).is_ok_and(|text| text.contains("Hamner")));
+    match (exp, hamner_readme) {
+        (_, Some(r)) => Some((subject, Some(r))),
+        (true, None) => Some((subject, None)),
+        (false, None) => None,
+    }
 }
 
 /// The body mass listed for `subject` in the README text (`subject01 72.84`).
@@ -141,6 +155,11 @@ pub fn apply(trial: &mut Trial, path: &Path, opts: &ReadOptions) -> Result<(), I
     let Some((subject, readme)) = layout(path) else {
         return Ok(());
     };
+    if readme.is_none() {
+        trial.notes.push(format!(
+            "OpenSim expData layout: subject {subject} from the folder names"
+        ));
+    }
     trial.subject.id = Some(subject.clone());
     trial.notes.push(format!(
         "Hamner & Delp (2013) running data set (subject {subject}); cite Hamner & Delp 2013 and \
@@ -161,22 +180,40 @@ pub fn apply(trial: &mut Trial, path: &Path, opts: &ReadOptions) -> Result<(), I
         }
         trial.gait = Some(Gait::Run);
     }
-    if let Ok(text) = std::fs::read_to_string(&readme) {
+    if let Some(text) = readme
+        .as_ref()
+        .and_then(|r| std::fs::read_to_string(r).ok())
+    {
         match mass_from_readme(&text, &subject) {
             Some(m) => {
                 trial.subject.mass_kg = Some(m);
-                trial
-                    .subject
-                    .notes
-                    .push(format!("mass {m} kg from {}", readme.display()));
+                trial.subject.notes.push(format!(
+                    "mass {m} kg from {}",
+                    readme
+                        .as_ref()
+                        .map(|r| r.display().to_string())
+                        .unwrap_or_default()
+                ));
             }
             None => trial.subject.notes.push(format!(
                 "mass: {subject} not listed in {}",
-                readme.display()
+                readme
+                    .as_ref()
+                    .map(|r| r.display().to_string())
+                    .unwrap_or_default()
             )),
         }
     }
-    let static_path = path.with_file_name("static.trc");
+    // static.trc beside the file, else in the subject folder (expData layout).
+    let static_path = [path.with_file_name("static.trc")]
+        .into_iter()
+        .chain(
+            path.parent()
+                .and_then(|d| d.parent())
+                .map(|d| d.join("static.trc")),
+        )
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| path.with_file_name("static.trc"));
     if static_path.is_file() {
         let (markers, _, _) = trc::read_markers(&static_path)?;
         match leg_from_static(&markers) {
@@ -186,6 +223,10 @@ pub fn apply(trial: &mut Trial, path: &Path, opts: &ReadOptions) -> Result<(), I
                 if chain.is_finite() {
                     let h = chain / LEG_FRACTION_OF_HEIGHT;
                     trial.subject.body_height_m = Some(h);
+                    trial.notes.push(format!(
+                        "warning: body height {h:.3} m estimated (not in the data) from \
+                         static.trc's hip-to-ankle length"
+                    ));
                     trial.subject.notes.push(format!(
                         "body height {h:.3} m ESTIMATED (not in the data) from the hip-to-ankle \
                          length {chain:.3} m of static.trc as thigh + shank = 0.48225·h \
@@ -205,6 +246,17 @@ pub fn apply(trial: &mut Trial, path: &Path, opts: &ReadOptions) -> Result<(), I
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn opensim_exp_data_layout_is_recognised_by_its_folders() {
+        let (subject, readme) =
+            layout(Path::new("/nowhere/subject03/expData/Run_4_grf.mot")).unwrap();
+        assert_eq!((subject.as_str(), readme), ("subject03", None));
+        assert!(layout(Path::new("/nowhere/subject03/ExpData/Run_4.trc")).is_some());
+        // Without expData, the shared layout needs its README.
+        assert!(layout(Path::new("/nowhere/subject03/Run_4_grf.mot")).is_none());
+        assert!(layout(Path::new("/nowhere/subjectX/expData/Run_4_grf.mot")).is_none());
+    }
 
     #[test]
     fn speed_and_mass_parsing() {

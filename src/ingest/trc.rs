@@ -17,8 +17,9 @@
 //! - An empty cell, `NaN`, or a marker at exactly (0, 0, 0) is a missing sample (gap-filled and
 //!   reported by [`super::gaps`]); `±inf` and text are errors naming row and marker.
 //! - A row with fewer cells than `Frame#`, `Time` and X/Y/Z for each of the `NumMarkers` declared
-//!   markers is an error (truncated or corrupt file), as is a file with fewer data rows than
-//!   `NumFrames`. Cortex writes extra (virtual, `V_…`) marker names beyond `NumMarkers` with
+//!   markers is an error (truncated or corrupt file). Fewer whole data rows than `NumFrames`
+//!   (a header that over-counts its frames, as in half of the upstream Hamner TRC files) are
+//!   read, with a `warning:` note. Cortex writes extra (virtual, `V_…`) marker names beyond `NumMarkers` with
 //!   empty columns: those are read when present and dropped, with a note, when they hold no data.
 use super::text;
 use super::types::{MarkerSet, Trial};
@@ -300,20 +301,20 @@ pub fn parse_markers(
         frames.push(frame_no);
         lines_of.push(ln);
     }
-    if time.len() < num_frames {
-        return Err(IngestError::malformed(
-            path,
-            format!(
-                "NumFrames = {num_frames} but only {} data rows: the file is truncated",
-                time.len()
-            ),
-        ));
-    }
     if time.is_empty() {
         return Err(IngestError::malformed(path, "no data rows"));
     }
     text::check_time(&time, &lines_of, path, "Time")?;
     let mut notes = Vec::new();
+    if time.len() < num_frames {
+        // Every row is whole (a row cut short is an error above): the header over-counts its
+        // frames, as half of the upstream Hamner TRC files do.
+        notes.push(format!(
+            "warning: NumFrames = {num_frames} but the file holds {} whole data rows; those \
+             rows read (the header over-counts its frames, or the file was cut at a row end)",
+            time.len()
+        ));
+    }
     if time.len() > num_frames {
         notes.push(format!(
             "{} data rows although NumFrames = {num_frames}; all rows read",
@@ -422,9 +423,15 @@ mod tests {
         let unit = trc(&["1\t0.00\t1\t2\t3\t10\t1\t1"], 1, "furlongs");
         let e = parse_markers(unit.as_bytes(), p).unwrap_err().to_string();
         assert!(e.contains("Units") && e.contains("furlongs"), "{e}");
-        let trunc = trc(&["1\t0.00\t1\t2\t3\t10\t1\t1"], 5, "mm");
-        let e = parse_markers(trunc.as_bytes(), p).unwrap_err().to_string();
-        assert!(e.contains("truncated"), "{e}");
+        let over = trc(&["1\t0.00\t1\t2\t3\t10\t1\t1"], 5, "mm");
+        let (m, _, notes) = parse_markers(over.as_bytes(), p).unwrap();
+        assert_eq!(m.len(), 1);
+        assert!(
+            notes
+                .iter()
+                .any(|n| n.starts_with("warning:") && n.contains("NumFrames = 5")),
+            "{notes:?}"
+        );
         let back = trc(
             &["1\t0.01\t1\t2\t3\t10\t1\t1", "2\t0.00\t1\t2\t3\t10\t1\t1"],
             2,
