@@ -129,6 +129,9 @@ pub enum EventSource {
     FootMarkers,
     /// Heel and toe speed over the ground within the Zeni windows (walking; Bonci et al. 2022).
     FootSpeed,
+    /// Running: heel/metatarsal vertical jerk peak at touchdown (after Handsaker et al. 2016)
+    /// and the toe's speed over the ground at toe off.
+    FootJerk,
     /// Read from the input file (e.g. a C3D EVENT group); kept for comparison, never overwritten.
     Reference,
     /// Produced by one of gaitfit's generators.
@@ -146,6 +149,7 @@ impl EventSource {
             EventSource::ZeniVelocity => "zeni_velocity",
             EventSource::FootMarkers => "foot_height",
             EventSource::FootSpeed => "foot_speed",
+            EventSource::FootJerk => "foot_jerk",
             EventSource::Reference => "reference",
             EventSource::Generated => "generated",
         }

@@ -57,6 +57,24 @@ pub struct KinematicOptions {
     /// fraction of the walking speed (default 0.8, Bonci et al. 2022).
     #[serde(default = "default_to_fraction")]
     pub to_speed_fraction: f64,
+    /// Running foot detector ([`Kinematics::run_foot`]): low-pass cutoff of the heel,
+    /// metatarsal and toe markers whose derivatives it reads, Hz (default 15; chosen on Hamner
+    /// subject01 Run_2 and Run_3, where 10–20 Hz give the same events within 1 ms).
+    #[serde(default = "default_run_cutoff")]
+    pub run_cutoff_hz: f64,
+    /// Running foot detector: toe off when the toe's 3-D speed over the ground rises through
+    /// this fraction of the running speed (default 0.35; chosen on Hamner subject01 Run_2 and
+    /// Run_3 — 0.30/0.35/0.40 give −12/−2/+7 ms there — and validated on Run_4 and Run_5).
+    #[serde(default = "default_run_to_fraction")]
+    pub run_to_speed_fraction: f64,
+}
+
+fn default_run_cutoff() -> f64 {
+    15.0
+}
+
+fn default_run_to_fraction() -> f64 {
+    0.35
 }
 
 fn default_hs_fraction() -> f64 {
@@ -78,6 +96,8 @@ impl Default for KinematicOptions {
             edge_frames: 2,
             hs_speed_fraction: default_hs_fraction(),
             to_speed_fraction: default_to_fraction(),
+            run_cutoff_hz: default_run_cutoff(),
+            run_to_speed_fraction: default_run_to_fraction(),
         }
     }
 }
@@ -126,6 +146,10 @@ pub struct Kinematics {
     pub pelvis_height: Vec<f64>,
     /// Left and right legs (index 0 left, 1 right).
     pub legs: [LegTrajectories; 2],
+    /// Heel, metatarsal and toe of each leg (index 0 left, 1 right) low-passed at
+    /// [`KinematicOptions::run_cutoff_hz`], for the running foot detector's derivatives.
+    #[serde(default)]
+    pub run_feet: [LegTrajectories; 2],
     /// The marker map in use.
     pub map: MarkerMap,
     /// What was detected or assumed.
@@ -403,6 +427,25 @@ impl Kinematics {
                 *nm = name.clone();
             }
         }
+        let rfilter = Butterworth::low_pass(
+            opts.order,
+            opts.run_cutoff_hz.min(0.45 * ms.rate_hz),
+            ms.rate_hz,
+        )?;
+        let mut run_feet: [LegTrajectories; 2] = Default::default();
+        if b - a >= rfilter.min_len().max(3) {
+            for s in 0..2 {
+                for (role, _, t) in &raw_legs[s] {
+                    let slot = match *role {
+                        "heel" => &mut run_feet[s].heel,
+                        "toe" => &mut run_feet[s].toe,
+                        "meta" => &mut run_feet[s].meta,
+                        _ => continue,
+                    };
+                    *slot = Some(filter_traj(&rfilter, &t[a..b]));
+                }
+            }
+        }
         let time_s = ms.time_s[a..b].to_vec();
         // Axes.
         let (vertical, forward, forward_sign) = match &trial.frame {
@@ -449,6 +492,7 @@ impl Kinematics {
             pelvis,
             pelvis_height,
             legs,
+            run_feet,
             map,
             notes,
         })
@@ -757,6 +801,138 @@ impl Kinematics {
                         side,
                         kind: e.kind,
                         source: EventSource::FootSpeed,
+                    });
+                }
+            }
+        }
+        out.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        out
+    }
+
+    /// Running events from the foot markers (treadmill or overground). Stances and swings are
+    /// the minima and maxima of the foot centre's height (mean of heel and toe at the marker
+    /// cutoff, hysteresis as for Zeni). In each stance, with the heel, metatarsal and toe
+    /// markers low-passed at `run_cutoff_hz`:
+    /// - heel strike: for the heel and for the metatarsal marker, the landing impact is the
+    ///   last peak of upward vertical acceleration before the marker's lowest point of the
+    ///   stance, and touchdown the vertical jerk peak that leads it (the onset of the impact
+    ///   deceleration); the earlier of the two markers (Handsaker et al. 2016, *A kinematic
+    ///   algorithm to identify gait events during running at different speeds and with
+    ///   different footstrike types*, J Biomech 49:4128–4133: heel or first-metatarsal
+    ///   marker, whichever lands first; they tested acceleration and jerk peaks, and
+    ///   recommend the acceleration peak at 250 Hz — at 100 Hz it is 9–22 ms late on Hamner,
+    ///   growing with speed, the jerk peak −8 to +2 ms);
+    /// - toe off: the first time after the stance's lowest point that the toe marker's 3-D
+    ///   speed over the ground rises through `run_to_speed_fraction` × the running speed
+    ///   (as [`Kinematics::foot_speed`], with the running fraction chosen on Hamner
+    ///   subject01 Run_2/Run_3 and validated on Run_4/Run_5).
+    ///
+    /// A stance cut by the record keeps the event the record still holds (its window runs to
+    /// the record's end). `seeds` (Zeni events) give the ground's velocity and the running
+    /// speed. Running only: the rules were chosen and validated on running.
+    pub fn run_foot(&self, seeds: &[GaitEvent], opts: &KinematicOptions) -> Vec<GaitEvent> {
+        let mut out = Vec::new();
+        let Some((ground, speed)) = self.ground_and_walking_speed(seeds) else {
+            return out;
+        };
+        let n = self.time_s.len();
+        if n < 5 {
+            return out;
+        }
+        let dt = 1.0 / self.rate_hz;
+        let ground_vel = ground * self.forward_sign;
+        let fwd_axis = self.forward;
+        let deriv = |x: &[f64]| -> Vec<f64> {
+            (0..x.len())
+                .map(|i| {
+                    let (a, b) = (i.saturating_sub(1), (i + 1).min(x.len() - 1));
+                    (x[b] - x[a]) / ((b - a).max(1) as f64 * dt)
+                })
+                .collect()
+        };
+        let peaks = |x: &[f64], lo: usize, hi: usize| -> Vec<usize> {
+            (lo.max(1)..hi.min(x.len() - 1))
+                .filter(|&i| x[i] >= x[i - 1] && x[i] > x[i + 1])
+                .collect()
+        };
+        for side in [Side::Left, Side::Right] {
+            let (l, f) = (self.leg(side), &self.run_feet[side_index(side)]);
+            let (Some(heel), Some(toe), Some(fheel), Some(ftoe)) =
+                (&l.heel, &l.toe, &f.heel, &f.toe)
+            else {
+                continue;
+            };
+            let centre: Vec<f64> = heel
+                .iter()
+                .zip(toe)
+                .map(|(h, t)| 0.5 * (self.up(h) + self.up(t)))
+                .collect();
+            let Some(delta) = self.delta(&centre, opts) else {
+                continue;
+            };
+            let ext = hysteresis_extrema(&centre, delta);
+            let landing: Vec<&Vec<[f64; 3]>> = [Some(fheel), f.meta.as_ref()]
+                .into_iter()
+                .flatten()
+                .collect();
+            let heights: Vec<Vec<f64>> = landing
+                .iter()
+                .map(|m| m.iter().map(|p| self.up(p)).collect())
+                .collect();
+            let accel: Vec<Vec<f64>> = heights.iter().map(|h| deriv(&deriv(h))).collect();
+            let jerk: Vec<Vec<f64>> = accel.iter().map(|a| deriv(a)).collect();
+            let toe_speed: Vec<f64> = self
+                .velocity(ftoe)
+                .into_iter()
+                .map(|mut v| {
+                    v[fwd_axis] -= ground_vel;
+                    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
+                })
+                .collect();
+            let level = opts.run_to_speed_fraction * speed;
+            for (k, &(m, is_max)) in ext.iter().enumerate() {
+                if is_max {
+                    continue;
+                }
+                let before = ext[..k].iter().rev().find(|e| e.1).map_or(0, |e| e.0);
+                let after = ext[k + 1..].iter().find(|e| e.1).map_or(n - 1, |e| e.0);
+                // Heel strike: per landing marker, the jerk peak leading its impact.
+                let mut hs: Option<f64> = None;
+                for ((h, a), j) in heights.iter().zip(&accel).zip(&jerk) {
+                    let low = (before..=after)
+                        .min_by(|&x, &y| h[x].total_cmp(&h[y]))
+                        .unwrap_or(m);
+                    let Some(&impact) = peaks(a, before + 1, low + 1)
+                        .iter()
+                        .rev()
+                        .find(|&&i| a[i] > 0.0)
+                    else {
+                        continue;
+                    };
+                    let Some(&onset) = peaks(j, before + 1, impact + 1).last() else {
+                        continue;
+                    };
+                    let t = self.time_s[onset] + parabolic_offset(j, onset) * dt;
+                    hs = Some(hs.map_or(t, |u| u.min(t)));
+                }
+                if let Some(t) = hs {
+                    out.push(GaitEvent {
+                        time_s: t,
+                        side,
+                        kind: EventKind::HeelStrike,
+                        source: EventSource::FootJerk,
+                    });
+                }
+                // Toe off: the toe's speed over the ground rising through the level.
+                if let Some(i) = (m..after.min(n - 1))
+                    .find(|&i| toe_speed[i] <= level && toe_speed[i + 1] > level)
+                {
+                    let w = (level - toe_speed[i]) / (toe_speed[i + 1] - toe_speed[i]);
+                    out.push(GaitEvent {
+                        time_s: self.time_s[i] + w.clamp(0.0, 1.0) * dt,
+                        side,
+                        kind: EventKind::ToeOff,
+                        source: EventSource::FootJerk,
                     });
                 }
             }

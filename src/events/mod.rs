@@ -162,20 +162,30 @@ pub enum PrimarySource {
     FootHeight,
     /// Heel and toe speed over the ground in the Zeni windows (walking; Bonci et al. 2022).
     FootSpeed,
+    /// Running: heel/metatarsal jerk peak at touchdown and the toe's speed over the ground at
+    /// toe off (see [`kinematic::Kinematics::run_foot`]).
+    FootJerk,
+    /// The markers' method for the trial's gait, told from the data (the Zeni events: at most
+    /// heel strikes, is the other foot on the ground or in the air?): `foot-speed` for a walk,
+    /// `foot-jerk` for a run.
+    Kinematic,
     /// The events stored in the file (C3D EVENT group).
     Reference,
 }
 
 impl PrimarySource {
-    /// Parses `auto|force|zeni|zeni-coordinate|zeni-velocity|foot-height|foot-speed|reference`.
+    /// Parses `auto|force|kinematic|zeni|zeni-coordinate|zeni-velocity|foot-height|foot-speed|
+    /// foot-jerk|reference`.
     pub fn parse(s: &str) -> Option<Self> {
         match s.trim().to_ascii_lowercase().replace('_', "-").as_str() {
             "auto" => Some(Self::Auto),
             "force" => Some(Self::Force),
-            "zeni" | "zeni-coordinate" | "coordinate" | "kinematic" => Some(Self::ZeniCoordinate),
+            "kinematic" | "markers" => Some(Self::Kinematic),
+            "zeni" | "zeni-coordinate" | "coordinate" => Some(Self::ZeniCoordinate),
             "zeni-velocity" | "velocity" => Some(Self::ZeniVelocity),
             "foot" | "foot-height" => Some(Self::FootHeight),
             "foot-speed" | "speed" | "bonci" => Some(Self::FootSpeed),
+            "foot-jerk" | "jerk" | "run-foot" => Some(Self::FootJerk),
             "reference" | "c3d" => Some(Self::Reference),
             _ => None,
         }
@@ -238,6 +248,13 @@ pub struct TrialEvents {
     /// Heel strike and toe off from the heel and toe speed over the ground within the Zeni
     /// windows (walking trials only; see [`kinematic::Kinematics::foot_speed`]).
     pub foot_speed: Vec<GaitEvent>,
+    /// Running heel strike and toe off from the foot markers' jerk and speed (running trials
+    /// only; see [`kinematic::Kinematics::run_foot`]).
+    #[serde(default)]
+    pub foot_jerk: Vec<GaitEvent>,
+    /// Whether the trial is a walk (from the options, the file, else the Zeni events).
+    #[serde(default)]
+    pub walking: bool,
     /// Foot-marker phases of the primary stances (foot flat, heel off, meta off, and toe off
     /// from a distinct toe marker).
     pub phases: Vec<GaitEvent>,
@@ -258,6 +275,7 @@ impl TrialEvents {
             EventSource::ZeniVelocity => &self.zeni_velocity,
             EventSource::FootMarkers => &self.foot_contact,
             EventSource::FootSpeed => &self.foot_speed,
+            EventSource::FootJerk => &self.foot_jerk,
             EventSource::Reference => &self.reference,
             EventSource::Generated => &[],
         }
@@ -308,6 +326,10 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         Some(k) if walking => k.foot_speed(&zc, &opts.kinematic),
         _ => Vec::new(),
     };
+    let fj = match &kin {
+        Some(k) if !walking => k.run_foot(&zc, &opts.kinematic),
+        _ => Vec::new(),
+    };
     let mut ev = TrialEvents {
         path: path.clone(),
         trial: trial.name.clone(),
@@ -318,6 +340,8 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         zeni_velocity: zv,
         foot_contact: fc,
         foot_speed: fs,
+        foot_jerk: fj,
+        walking,
         phases: Vec::new(),
         reference: trial.reference_events.clone(),
         primary: EventSource::Force,
@@ -429,6 +453,23 @@ fn choose_primary(
             EventSource::FootSpeed,
             "the foot-speed detector (walking only: pass --gait walk if the trial is a walk)",
         ),
+        PrimarySource::FootJerk => need(
+            EventSource::FootJerk,
+            "the running foot detector (running only: pass --gait run if the trial is a run)",
+        ),
+        PrimarySource::Kinematic => {
+            if ev.walking {
+                need(
+                    EventSource::FootSpeed,
+                    "the walking foot-speed detector (the trial walks, told from the data)",
+                )
+            } else {
+                need(
+                    EventSource::FootJerk,
+                    "the running foot detector (the trial runs, told from the data)",
+                )
+            }
+        }
         PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
         PrimarySource::Auto => {
             // The file's own events come before the Zeni estimate: on the shared overground
@@ -450,6 +491,10 @@ fn choose_primary(
                 // Walking from markers alone: the Zeni windows refined by the foot's own speed
                 // over the ground, which removes the Zeni heel-strike bias (reports/events.md).
                 Ok(EventSource::FootSpeed)
+            } else if has_both_kinds(&ev.foot_jerk) {
+                // Running from markers alone: touchdown at the foot's impact jerk, toe off at
+                // the toe's speed over the ground (reports/events.md).
+                Ok(EventSource::FootJerk)
             } else if has_both_kinds(&ev.zeni_coordinate) {
                 Ok(EventSource::ZeniCoordinate)
             } else if has_both_kinds(&ev.reference) {
@@ -521,9 +566,11 @@ impl Analysis {
             ("zeni_velocity", &self.events.zeni_velocity),
             ("foot_height", &self.events.foot_contact),
             ("foot_speed", &self.events.foot_speed),
+            ("foot_jerk", &self.events.foot_jerk),
         ] {
-            // The foot-speed detector runs on walks only: no row for a run.
-            if name == "foot_speed" && det.is_empty() {
+            // The foot-speed detector runs on walks only, the foot-jerk one on runs: no row
+            // for the other gait.
+            if (name == "foot_speed" || name == "foot_jerk") && det.is_empty() {
                 continue;
             }
             let res = compare::compare(det, refs, coverage, span, tol_s);
