@@ -260,6 +260,14 @@ pub struct CompareTable {
     /// The accumulated double-support errors (see [`double_support_errors`]).
     #[serde(default)]
     pub double_support: BTreeMap<(String, String), DoubleSupportCounts>,
+    /// Reference events (heel strikes and toe offs) within the matching tolerance of either end
+    /// of the marker record: scored like the others (a miss counts against recall); counted so
+    /// the table can say so.
+    #[serde(default)]
+    pub near_ends: usize,
+    /// All reference events scored (heel strikes and toe offs).
+    #[serde(default)]
+    pub scored: usize,
 }
 
 impl CompareTable {
@@ -285,6 +293,8 @@ impl CompareTable {
 
     /// Adds every row of another table.
     pub fn merge(&mut self, other: &CompareTable) {
+        self.near_ends += other.near_ends;
+        self.scored += other.scored;
         for (k, c) in &other.rows {
             self.rows.entry(k.clone()).or_default().merge(c);
         }
@@ -313,6 +323,14 @@ impl CompareTable {
                 f(c.recall(), 3),
                 f(c.mean_ms(), 1),
                 f(c.sd_ms(), 1)
+            ));
+        }
+        if self.scored > 0 {
+            s.push_str(&format!(
+                "every reference event inside the marker record is scored: {} event(s), {} of \
+                 them within the matching tolerance of a record end (a miss there counts \
+                 against recall like any other)\n",
+                self.scored, self.near_ends
             ));
         }
         if self.double_support.values().any(|d| !d.errors_s.is_empty()) {

@@ -780,6 +780,51 @@ impl Kinematics {
                 continue;
             };
             let (sh, st) = (speed_over_ground(heel), speed_over_ground(toe));
+            // Record ends: an event whose Zeni extremum the record cuts has no seed. When the
+            // foot's first seed is a toe off the foot was on the ground at the start, so its
+            // heel strike may lie just inside the record: a heel seed opens [start, toe off
+            // − 0.2 s]. Likewise a foot whose last seed is a heel strike may lift before the
+            // end ([heel strike + 0.25 s, end]), and one whose last seed is a toe off may land
+            // ([toe off + 0.2 s, end]). A window with no crossing gives no event.
+            let mine: Vec<&GaitEvent> = seeds.iter().filter(|e| e.side == side).collect();
+            let mut extra: Vec<(EventKind, usize, usize)> = Vec::new();
+            let t_end = self.time_s[n - 1];
+            if let Some(first) = mine.first() {
+                if first.kind == EventKind::ToeOff && first.time_s - 0.2 > self.time_s[0] {
+                    extra.push((EventKind::HeelStrike, 0, self.frame_at(first.time_s - 0.2)));
+                }
+            }
+            if let Some(last) = mine.last() {
+                let (kind, gap) = match last.kind {
+                    EventKind::HeelStrike => (EventKind::ToeOff, 0.25),
+                    _ => (EventKind::HeelStrike, 0.2),
+                };
+                if last.time_s + gap < t_end {
+                    extra.push((kind, self.frame_at(last.time_s + gap), n - 1));
+                }
+            }
+            for (kind, a, b) in extra {
+                let (s, level, falling) = match kind {
+                    EventKind::HeelStrike => (&sh, opts.hs_speed_fraction * speed, true),
+                    _ => (&st, opts.to_speed_fraction * speed, false),
+                };
+                let crossing = (a..b.min(n - 1)).find(|&i| {
+                    if falling {
+                        s[i] >= level && s[i + 1] < level
+                    } else {
+                        s[i] <= level && s[i + 1] > level
+                    }
+                });
+                if let Some(i) = crossing {
+                    let w = (level - s[i]) / (s[i + 1] - s[i]);
+                    out.push(GaitEvent {
+                        time_s: self.time_s[i] + w.clamp(0.0, 1.0) / self.rate_hz,
+                        side,
+                        kind,
+                        source: EventSource::FootSpeed,
+                    });
+                }
+            }
             for e in seeds.iter().filter(|e| e.side == side) {
                 let (s, level, falling, lo, hi) = match e.kind {
                     EventKind::HeelStrike => (&sh, opts.hs_speed_fraction * speed, true, -0.1, 0.2),

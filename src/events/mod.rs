@@ -553,10 +553,25 @@ impl Analysis {
                 (f64::NEG_INFINITY, f64::INFINITY),
             ),
         };
-        // An extremum cannot be seen at the very edge of the marker record: reference events
-        // within the tolerance of either end are not judged (they would count as misses).
-        span.0 = span.0.max(k.time_s[0] + tol_s);
-        span.1 = span.1.min(k.time_s[k.time_s.len() - 1] - tol_s);
+        // Every reference event inside the marker record is judged, including those at its
+        // ends (issue 19: leaving them out overstated recall); the table says how many lie
+        // within the tolerance of an end.
+        let (k0, k1) = (k.time_s[0], k.time_s[k.time_s.len() - 1]);
+        span.0 = span.0.max(k0);
+        span.1 = span.1.min(k1);
+        let judged: Vec<&GaitEvent> = refs
+            .iter()
+            .filter(|e| {
+                matches!(e.kind, EventKind::HeelStrike | EventKind::ToeOff)
+                    && e.time_s >= span.0
+                    && e.time_s <= span.1
+            })
+            .collect();
+        table.scored = judged.len();
+        table.near_ends = judged
+            .iter()
+            .filter(|e| e.time_s < k0 + tol_s || e.time_s > k1 - tol_s)
+            .count();
         let rname = match reference {
             EventSource::Force => "force",
             _ => "reference",
