@@ -36,6 +36,13 @@ events build them) is in the `data/*.csv` tables.
 
 ## Findings
 
+- **Issue 19 (latest).** Running from markers alone: `foot_jerk` (`--events kinematic` on a
+  run) against numpy's 20 N events on Hamner subject01, every event in the record: heel strike
+  −3 ± 5 ms (recall 0.98), toe off −4 ± 6 ms (recall 1.00); gaitkit's Zeni toe off +54 ms,
+  recall 0.16 (side by side at the end). Walking (`foot_speed`) on the 12 Schreiber trials
+  with the heel strikes at each record's start now scored: −13 ± 10 ms, recall 0.96; toe off
+  −12 ± 6 ms, recall 1.00 (gaitkit BIKE −20 ± 12 / −10 ± 7 ms, recall 1.00). Some bullets
+  below predate these changes.
 - **Walking, kinematic vs force.** The Zeni et al. (2008) coordinate method misses the aim
   (|mean| ≤ 10 ms, SD ≤ 15 ms) at heel strike on both overground data sets with plates: about
   −34 ± 8 ms (Schreiber) and −36 ± 12 ms (BMClab walk), i.e. early. The foot-speed detector
@@ -133,6 +140,23 @@ run "BMClab Gait.c3d (a Vicon C3D walking sample; two plates, one contact each)"
 run "BMClab running trial (one contact per foot)" bmclab/motion_capture_run.trc+bmclab/grf_run.mot --compare force
 run "Hamner subject01 (the runner with markers), treadmill" hamner2013/subject01 --compare force
 run "Schreiber: kinematic methods vs the C3D's own events" schreiber2019 --compare reference
+cat <<'EOF'
+
+## gaitkit 1.5 side by side (issue 19)
+
+Made by `/work/venv/bin/python tools/events/gaitkit_side_by_side.py` (optional, not CI; its
+output is committed as `tools/events/gaitkit_side_by_side.txt` and copied here). Both tools
+are scored by the script the same way: every plate event inside the marker record, ends
+included, 60 ms matching. Walking reference: gaitfit's plate events on Schreiber; running
+reference: `tools/events/hamner_force_events.csv` (numpy, no gaitfit). gaitfit `kinematic` is
+foot_speed for walks and foot_jerk for runs; s/trial is per file, gaitfit one process for all
+files, gaitkit per call in Python. On Hamner gaitkit's angle-based methods get proxy ankle and
+knee points (no malleoli or epicondyles in those TRCs); zeni is its running default.
+
+```
+EOF
+cat tools/events/gaitkit_side_by_side.txt
+printf '```\n'
 } > "$TMP"
 mv "$TMP" "$OUT"
 echo "wrote $OUT"
