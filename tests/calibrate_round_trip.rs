@@ -82,3 +82,67 @@ fn walks_read_back_as_walks_with_their_cadence_and_step_length() {
         check(Gait::Walk, v, h);
     }
 }
+
+/// `gaitfit generate run|walk --calibration FILE` reads a calibrated.json and applies the
+/// subject's offsets: a step-length offset of +5 cm shows in the generated plan.
+#[test]
+fn generate_reuses_a_calibration_file() {
+    use gaitfit::calibrate::{CalibratedAttr, CalibratedFile, CalibratedSubject};
+    let dir = tempfile::tempdir().unwrap();
+    let attr = |name: &str, unit: &str, v: f64| CalibratedAttr {
+        name: name.into(),
+        unit: unit.into(),
+        before: 0.0,
+        value: v,
+        se: None,
+    };
+    let f = CalibratedFile {
+        format: CalibratedFile::FORMAT.into(),
+        relations: "published".into(),
+        subjects: vec![CalibratedSubject {
+            subject: "s1".into(),
+            gait: Gait::Run,
+            body_height_m: 1.8,
+            mass_kg: 70.0,
+            speeds_m_per_s: vec![3.5],
+            attributes: vec![
+                attr("step_length_offset_m", "m", 0.05),
+                attr("flight_time_offset_s", "s", 0.0),
+                attr("bounciness_deg", "deg", 40.0),
+            ],
+        }],
+    };
+    let cal = dir.path().join("calibrated.json");
+    std::fs::write(&cal, serde_json::to_string(&f).unwrap()).unwrap();
+    let plan = |extra: &[&str]| -> f64 {
+        let out = dir.path().join("r.csv");
+        let plan = dir.path().join("plan.csv");
+        let mut args = vec![
+            "generate",
+            "run",
+            "--speed",
+            "3.5",
+            "--seconds",
+            "3",
+            "--no-stop",
+            "-o",
+        ];
+        let (o, p) = (out.to_str().unwrap(), plan.to_str().unwrap());
+        args.extend([o, "--plan", p]);
+        args.extend(extra);
+        assert_cmd::Command::cargo_bin("gaitfit")
+            .unwrap()
+            .args(&args)
+            .assert()
+            .success();
+        let text = std::fs::read_to_string(&plan).unwrap();
+        let last = text.lines().nth(4).unwrap().to_string();
+        last.split(',').nth(6).unwrap().parse().unwrap()
+    };
+    let base = plan(&[]);
+    let calibrated = plan(&["--calibration", cal.to_str().unwrap()]);
+    assert!(
+        (calibrated - base - 0.05).abs() < 1e-3,
+        "step length {base} → {calibrated}"
+    );
+}

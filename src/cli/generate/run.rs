@@ -2,6 +2,7 @@
 //! optionally step length, step frequency, flight height, level, attributes, a per-step
 //! schedule), written as BVH, CSV (+ events CSV) or TRC.
 use super::common::{freq_arg, length_arg, speed_arg, Common};
+use crate::events::Gait;
 use crate::generator::running::attributes::{unit_name, AttrUnit, SPECS};
 use crate::generator::running::equations::RunRelations;
 use crate::generator::running::params::default_mass;
@@ -51,6 +52,12 @@ pub struct Args {
     /// coefficients otherwise.
     #[arg(long)]
     pub fits: Option<PathBuf>,
+    /// A subject's calibration (`gaitfit calibrate … --out DIR` writes DIR/calibrated.json):
+    /// its offsets in the relations and its calibrated attributes; `--subject` picks the subject
+    /// when the file holds several. The offsets are the subject's: give `--height` its body
+    /// height.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<PathBuf>,
     /// Do not stop at the end (by default the run ends standing by --seconds, or after --count
     /// steps).
     #[arg(long = "no-stop")]
@@ -90,6 +97,29 @@ fn attribute_help() -> String {
     s
 }
 
+/// The attribute vector of `gait` for `subject` in a calibrated.json (see
+/// [`crate::calibrate::CalibratedFile`]), with a note when it was calibrated for another body
+/// height.
+pub(super) fn load_calibration(
+    path: &std::path::Path,
+    gait: Gait,
+    subject: Option<&str>,
+    height: f64,
+) -> anyhow::Result<[f64; 3]> {
+    use crate::calibrate::CalibratedFile;
+    let f = CalibratedFile::read(path)?;
+    let s = f
+        .pick(gait, subject)
+        .map_err(|e| anyhow::anyhow!("--calibration {}: {e}", path.display()))?;
+    if (s.body_height_m - height).abs() > 0.005 {
+        eprintln!(
+            "gaitfit: note: --calibration: {} was calibrated at body height {:.3} m; generating at {height} m",
+            s.subject, s.body_height_m
+        );
+    }
+    CalibratedFile::theta(s).map_err(|e| anyhow::anyhow!("--calibration {}: {e}", path.display()))
+}
+
 fn param_of(name: &str) -> anyhow::Result<Param> {
     Ok(match name.trim() {
         "speed" | "v" => Param::Speed,
@@ -117,6 +147,14 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     };
     let model = RunModel::new(skeleton, relations)?;
     let mut attrs = RunAttributes::defaults(height);
+    let calibration = match &args.calibration {
+        Some(path) => {
+            let theta = load_calibration(path, Gait::Run, c.subject.as_deref(), height)?;
+            attrs.set(Attr::Bounciness, theta[2].to_radians())?;
+            Some(theta)
+        }
+        None => None,
+    };
     for a in &args.attrs {
         let (name, val) = a
             .split_once('=')
@@ -155,9 +193,17 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         .find(|(p, _)| *p == Param::Speed)
         .map(|g| g.1)
         .unwrap_or(12.0 / 3.6);
-    let mut params = model.natural(start_v, args.level, &attrs)?;
+    let mut params = match &calibration {
+        // The subject's step length and flight time at this speed (calibrate::drive).
+        Some(theta) => crate::calibrate::drive::run_params(&model, &attrs, start_v, theta)?,
+        None => model.natural(start_v, args.level, &attrs)?,
+    };
     for &(p, v) in &given {
-        params = model.set(&params, p, v, &attrs)?;
+        // With a calibration the speed is already that of `run_params` (re-setting it would
+        // return to the relation's step length).
+        if !(calibration.is_some() && p == Param::Speed) {
+            params = model.set(&params, p, v, &attrs)?;
+        }
         params.locks.set(p, true);
     }
     params.locks = Default::default();

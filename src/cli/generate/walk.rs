@@ -39,6 +39,12 @@ pub struct Args {
     /// relations otherwise.
     #[arg(long)]
     pub fits: Option<std::path::PathBuf>,
+    /// A subject's calibration (`gaitfit calibrate … --out DIR` writes DIR/calibrated.json):
+    /// its offsets in the relations and its calibrated attributes; `--subject` picks the subject
+    /// when the file holds several. The offsets are the subject's: give `--height` its body
+    /// height.
+    #[arg(long, value_name = "FILE")]
+    pub calibration: Option<std::path::PathBuf>,
     /// Start standing, feet side by side (the first step starts from rest). Without it the walk
     /// starts steady, recorded from 5 frames before its first heel strike (mid-motion). Without
     /// --stop it ends 5 frames after the trailing toe off that follows its last heel strike.
@@ -153,6 +159,18 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         stop: args.stop,
         ..Default::default()
     };
+    let calibration = match &args.calibration {
+        Some(path) => Some(super::run::load_calibration(
+            path,
+            Gait::Walk,
+            c.subject.as_deref(),
+            args.height,
+        )?),
+        None => None,
+    };
+    if let Some(theta) = &calibration {
+        opts.attributes.set("leg_stiffness", theta[2])?;
+    }
     for a in &args.attrs {
         let Some((name, value)) = a.split_once('=') else {
             bail!("--attr {a:?}: expected name=value (see `gaitfit generate walk --help`)");
@@ -166,11 +184,29 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     if let Some(dir) = &args.fits {
         opts.relations = WalkRelations::from_fits_dir(dir)?;
     }
-    let params = WalkParams {
+    let mut params = WalkParams {
         speed_m_per_s: args.speed,
         step_length_m: args.step_length,
         step_freq_steps_per_min: args.step_freq.map(crate::units::hz_to_steps_per_min),
     };
+    if let Some(theta) = &calibration {
+        let r = &opts.relations.tds_sf;
+        opts.relations.tds_sf = crate::relations::WalkTdsSf::new(r.d0() + theta[1], r.d1());
+        match (args.speed, args.step_length, args.step_freq) {
+            (Some(v), None, None) => {
+                params.step_length_m = Some(
+                    opts.relations
+                        .sl_sf
+                        .step_length_for_speed(v * 60.0, args.height)
+                        + theta[0],
+                );
+            }
+            _ => eprintln!(
+                "gaitfit: note: --calibration: the step-length offset applies to --speed alone; \
+                 the step length and frequency given are kept"
+            ),
+        }
+    }
     let sched = match &c.schedule {
         Some(path) => Some(Schedule::from_csv(path)?),
         None => None,
