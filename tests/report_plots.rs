@@ -210,4 +210,25 @@ fn kb_mu_draws_one_labelled_panel_per_mu() {
     );
     let summary = read(dir.path(), "summary.md");
     assert!(summary.contains("one panel per output (4)"));
+    // The paper gives μ* at sl* and only ranges for α (appendix A): its constraint is drawn and
+    // named so, and nothing is labelled "published" — no flat α = 0 lines.
+    assert!(svg.contains("constraint: μ* at sl*"), "legend");
+    assert!(
+        !svg.lines().any(|l| l.trim() == "published"),
+        "a 'published' legend entry"
+    );
+    assert!(summary.contains("alpha1 ∈ [0, 0.3], alpha2 ≥ 0, alpha3 ≥ 0, alpha4 ≥ 0"));
+    assert!(summary.contains("so no published curve"));
+    // The coefficient table: no published α, no t-test for α; the overview's "published" r²
+    // is marked as a reference curve.
+    for k in 1..=4 {
+        let row = summary
+            .lines()
+            .find(|l| l.starts_with(&format!("| `alpha{k}` |")))
+            .unwrap_or_else(|| panic!("alpha{k} row"));
+        let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+        assert_eq!(cells[3], "—", "published alpha{k}: {row}");
+        assert_eq!(cells[7], "—", "t-test of alpha{k}: {row}");
+    }
+    assert!(summary.contains("so this is a reference, not a published curve"));
 }

@@ -90,6 +90,20 @@ enum LineKind {
     GroupMean(u16),
     /// A reference line (residual 0, the normal line of a Q–Q plot).
     Reference,
+    /// The paper's constraint where it gives ranges, not values (Ko–Badler's α): the region
+    /// of admissible curves and the point they all pass through.
+    Constraint,
+}
+
+/// What a paper that gives a range, not a value, for some coefficients says about the curve
+/// (Ko–Badler appendix A: α₁ ∈ [0, 0.3], α₂…α₄ > 0, with μᵢ* at sl* given): every curve with
+/// those coefficients anywhere in their ranges and the others at the paper's values.
+#[derive(Debug, Clone, Default)]
+struct Constraint {
+    /// `(x, lo, hi)`: the admissible curves' extent at `x`, clipped to the panel.
+    region: Vec<(f64, f64, f64)>,
+    /// Where every admissible curve passes (μ* at sl*), if they share a point in the panel.
+    pivot: Option<(f64, f64)>,
 }
 
 #[derive(Debug, Clone)]
@@ -111,6 +125,8 @@ struct Panel {
     /// `(x, lo, hi)` of the refit's 95 % band.
     band: Vec<(f64, f64, f64)>,
     lines: Vec<Line>,
+    /// The paper's constraint (drawn under the data), when it gives ranges, not values.
+    constraint: Option<Constraint>,
 }
 
 /// A figure, fully reduced: drawing it costs the same whatever the number of rows.
@@ -165,7 +181,140 @@ fn selector_input(rel: &dyn Relation) -> Option<usize> {
 /// curve through made-up values would look like the paper's).
 fn published_given(o: &FitOutcome) -> bool {
     let rel = o.published.as_ref();
-    rel.parameters().iter().all(|s| s.published.is_finite())
+    rel.parameters()
+        .iter()
+        .all(|s| s.cited && s.published.is_finite())
+}
+
+/// The coefficients the paper gives only a range for: `(index, lo, hi)` of every parameter it
+/// does not cite a value for but bounds (Ko–Badler's α); empty when it cites every value, or
+/// when some uncited coefficient has no range either (then the paper says nothing to draw).
+fn ranged_only(o: &FitOutcome) -> Vec<(usize, f64, f64)> {
+    let rel = o.published.as_ref();
+    let mut out = Vec::new();
+    for (i, s) in rel.parameters().iter().enumerate() {
+        if s.cited && s.published.is_finite() {
+            continue;
+        }
+        let (lo, hi) = rel.bounds(i);
+        if !(lo.is_finite() || hi.is_finite()) || !s.published.is_finite() {
+            return Vec::new();
+        }
+        out.push((i, lo, hi));
+    }
+    // 2^m corners per evaluation point.
+    if out.len() > 8 {
+        return Vec::new();
+    }
+    out
+}
+
+/// Stand-in for an infinite bound when the admissible curves are evaluated: its curves leave
+/// any panel, and the region is clipped to the panel (the half-fan of α > 0).
+const UNBOUNDED: f64 = 1e9;
+
+/// The paper's constraint for output `out` over `[xlo, xhi]` (other inputs at `base`): at each
+/// x the extent of the curves with the ranged coefficients at the corners of their ranges (exact
+/// for coefficients that enter linearly, as α does), and the point all of them pass through.
+/// Returns the region before clipping (`finite`: the corners of finite bounds only, for the
+/// axis range; `all`: with infinite bounds at ±[`UNBOUNDED`]) and the pivot.
+#[allow(clippy::type_complexity)]
+fn constraint_family(
+    o: &FitOutcome,
+    ranged: &[(usize, f64, f64)],
+    out: Option<usize>,
+    base: &[f64; MAX_INPUTS],
+    xlo: f64,
+    xhi: f64,
+) -> (
+    Vec<(f64, f64, f64)>,
+    Vec<(f64, f64, f64)>,
+    Option<(f64, f64)>,
+) {
+    let rel = o.published.as_ref();
+    let p0: Vec<f64> = rel.parameters().iter().map(|s| s.published).collect();
+    let eval = |p: &[f64], x0: f64| rel.predict_with(p, 0.0, &at(rel, base, out, x0));
+    // The pivot: where the curve stops depending on each ranged coefficient that matters here
+    // (a sign change of the unit-step difference between grid points, linear in between).
+    let grid: Vec<f64> = xs(xlo, xhi).collect();
+    let mut pivot_x: Option<f64> = None;
+    let mut consistent = true;
+    for &(i, _, _) in ranged {
+        let mut p1 = p0.clone();
+        p1[i] += 1.0;
+        let d: Vec<f64> = grid.iter().map(|&x| eval(&p1, x) - eval(&p0, x)).collect();
+        if d.iter().all(|v| v.abs() < 1e-12) {
+            continue; // this coefficient does not act on this output
+        }
+        let root = (0..grid.len()).find_map(|k| {
+            if d[k] == 0.0 {
+                Some(grid[k])
+            } else if k + 1 < grid.len() && d[k].signum() != d[k + 1].signum() && d[k + 1] != 0.0 {
+                Some(grid[k] + (grid[k + 1] - grid[k]) * d[k] / (d[k] - d[k + 1]))
+            } else {
+                None
+            }
+        });
+        match (root, pivot_x) {
+            (None, _) => consistent = false,
+            (Some(r), None) => pivot_x = Some(r),
+            (Some(r), Some(q)) => {
+                if (r - q).abs() > 1e-9 * (xhi - xlo) {
+                    consistent = false;
+                }
+            }
+        }
+    }
+    let pivot = pivot_x.filter(|_| consistent).map(|x| (x, eval(&p0, x)));
+    let mut xs_all = grid;
+    if let Some((x, _)) = pivot {
+        let k = xs_all.partition_point(|&v| v < x);
+        xs_all.insert(k, x);
+    }
+    let corners = |finite_only: bool| -> Vec<Vec<f64>> {
+        let mut sets: Vec<Vec<f64>> = vec![p0.clone()];
+        for &(i, lo, hi) in ranged {
+            let mut vals = Vec::new();
+            for b in [lo, hi] {
+                if b.is_finite() {
+                    vals.push(b);
+                } else if !finite_only {
+                    vals.push(b.signum() * UNBOUNDED);
+                }
+            }
+            if vals.is_empty() {
+                continue;
+            }
+            sets = sets
+                .into_iter()
+                .flat_map(|s| {
+                    vals.iter().map(move |&v| {
+                        let mut s = s.clone();
+                        s[i] = v;
+                        s
+                    })
+                })
+                .collect();
+        }
+        sets
+    };
+    let extent = |sets: &[Vec<f64>]| -> Vec<(f64, f64, f64)> {
+        xs_all
+            .iter()
+            .map(|&x| {
+                let (lo, hi) = sets
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+                        let y = eval(p, x);
+                        (a.0.min(y), a.1.max(y))
+                    });
+                (x, lo, hi)
+            })
+            .collect()
+    };
+    let finite = extent(&corners(true));
+    let all = extent(&corners(false));
+    (finite, all, pivot)
 }
 
 fn xs(lo: f64, hi: f64) -> impl Iterator<Item = f64> {
@@ -268,6 +417,32 @@ fn groups_legend(groups: &Groups) -> Option<(String, Vec<String>)> {
     })
 }
 
+/// The legend's words for the paper's constraint, `None` when there is none to draw.
+fn constraint_words(o: &FitOutcome, ranged: &[(usize, f64, f64)]) -> Option<String> {
+    if ranged.is_empty() {
+        return None;
+    }
+    let specs = o.published.parameters();
+    let range = |lo: f64, hi: f64| match (lo.is_finite(), hi.is_finite()) {
+        (true, true) => format!("∈ [{}, {}]", fmt_num(lo), fmt_num(hi)),
+        (true, false) => format!("≥ {}", fmt_num(lo)),
+        _ => format!("≤ {}", fmt_num(hi)),
+    };
+    let ranges: Vec<String> = ranged
+        .iter()
+        .map(|&(i, lo, hi)| format!("{} {}", specs[i].name, range(lo, hi)))
+        .collect();
+    let pivot = if o.record.relation == crate::relations::kb_mu::ID {
+        "μ* at sl* (the prototype's angles at its step length) and "
+    } else {
+        "the point they share and "
+    };
+    Some(format!(
+        "the paper's constraint: {pivot}the curves its ranges admit ({}); no values given",
+        ranges.join(", ")
+    ))
+}
+
 /// The data figure's sources: one panel per output.
 fn main_sources(rel: &dyn Relation) -> Vec<Source> {
     let outs: Vec<Option<usize>> = if rel.outputs() > 1 {
@@ -307,6 +482,11 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
     let per_group =
         frame.groups.len() > 1 && (!others.is_empty() || rel.subject_effect().is_some());
     let published = published_given(o);
+    let ranged = if published {
+        Vec::new()
+    } else {
+        ranged_only(o)
+    };
     let grid = grid_for(outs.len());
     let mut panels = Vec::new();
     for (src, e) in sources.iter().zip(ext) {
@@ -368,7 +548,25 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
                 }
             }
         }
+        let mut constraint = None;
+        if !ranged.is_empty() {
+            let (finite, all, pivot) = constraint_family(o, &ranged, out, &mean_x, xlo, xhi);
+            for &(_, lo, hi) in &finite {
+                if lo.is_finite() && hi.is_finite() {
+                    ylo = ylo.min(lo);
+                    yhi = yhi.max(hi);
+                }
+            }
+            constraint = Some((all, pivot));
+        }
         let y = pad(ylo, yhi);
+        let constraint = constraint.map(|(all, pivot)| Constraint {
+            region: all
+                .into_iter()
+                .map(|(x, lo, hi)| (x, lo.clamp(y.0, y.1), hi.clamp(y.0, y.1)))
+                .collect(),
+            pivot: pivot.filter(|p| p.1 >= y.0 && p.1 <= y.1),
+        });
         let y_desc = match out {
             Some(k) => format!("{} ({})", rel.output_name(k), resp.unit),
             None => format!("{} ({})", resp.symbol, resp.unit),
@@ -383,6 +581,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
             data: DataLayer::Points(Vec::new()),
             band,
             lines,
+            constraint,
         });
     }
     let at_means = others
@@ -405,8 +604,11 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
             format!("refit, average subject at {at_means} (mean)")
         },
     )];
+    let constraint_words = constraint_words(o, &ranged);
     if published {
         lines_legend.push((LineKind::Published, "published".into()));
+    } else if let Some(w) = &constraint_words {
+        lines_legend.push((LineKind::Constraint, w.clone()));
     } else {
         lines_legend.push((
             LineKind::Reference,
@@ -446,6 +648,8 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
     );
     if published {
         shows.push_str(", and the published curve");
+    } else if let Some(w) = &constraint_words {
+        shows.push_str(&format!("; red: {w}, so no published curve"));
     } else {
         shows.push_str("; no published curve (the paper gives no value for some coefficients)");
     }
@@ -548,6 +752,7 @@ fn residual_spec(frame: &Frame, sources: &[Source], ext: &[Extent], against_inpu
                 }],
                 data: DataLayer::Points(Vec::new()),
                 band: Vec::new(),
+                constraint: None,
             }
         })
         .collect();
@@ -642,6 +847,7 @@ fn qq_spec(frame: &Frame) -> Spec {
             pts: vec![(x.0, mean + sd * x.0), (x.1, mean + sd * x.1)],
             kind: LineKind::Reference,
         }],
+        constraint: None,
     };
     Spec {
         stem: format!("{id}-qq"),
@@ -684,6 +890,7 @@ fn draw_line<DB: DrawingBackend>(
         LineKind::GroupCurve(g) => (group_color(g), 2, false),
         LineKind::GroupMean(g) => (group_color(g), 2, false),
         LineKind::Reference => (RGBColor(90, 90, 90), 1, true),
+        LineKind::Constraint => (PUBLISHED, 1, true),
     };
     // A white halo keeps the fitted curves readable over points and density cells.
     if matches!(
@@ -765,6 +972,33 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
         .light_line_style(BLACK.mix(0.03))
         .draw()
         .map_err(err)?;
+    if let Some(c) = &p.constraint {
+        if c.region.len() >= 2 {
+            chart
+                .draw_series(std::iter::once(Polygon::new(
+                    c.region
+                        .iter()
+                        .map(|r| (r.0, r.2))
+                        .chain(c.region.iter().rev().map(|r| (r.0, r.1)))
+                        .collect::<Vec<_>>(),
+                    PUBLISHED.mix(0.10).filled(),
+                )))
+                .map_err(err)?;
+            for edge in [
+                c.region.iter().map(|r| (r.0, r.1)).collect::<Vec<_>>(),
+                c.region.iter().map(|r| (r.0, r.2)).collect::<Vec<_>>(),
+            ] {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        edge,
+                        6,
+                        4,
+                        PUBLISHED.mix(0.7).stroke_width(1),
+                    ))
+                    .map_err(err)?;
+            }
+        }
+    }
     match &p.data {
         DataLayer::Points(pts) => {
             chart
@@ -817,6 +1051,17 @@ fn draw_panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Panel) -> R
     }
     for l in &p.lines {
         draw_line(&mut chart, l)?;
+    }
+    if let Some((x, y)) = p.constraint.as_ref().and_then(|c| c.pivot) {
+        // A diamond (not a circle: circles are data), white-rimmed.
+        let shape = |r: i32| vec![(0, -r), (r, 0), (0, r), (-r, 0)];
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((x, y))
+                    + Polygon::new(shape(7), WHITE.filled())
+                    + Polygon::new(shape(5), PUBLISHED.filled()),
+            ))
+            .map_err(err)?;
     }
     Ok(())
 }
@@ -970,12 +1215,25 @@ fn draw_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, s: &Spec) -> R
                         BAND.mix(0.35).filled(),
                     ))
                     .map_err(err),
+                Some(LineKind::Constraint) => {
+                    a.draw(&Rectangle::new(
+                        [(8, y + 1), (26, y + 13)],
+                        PUBLISHED.mix(0.10).filled(),
+                    ))
+                    .map_err(err)?;
+                    let (cx, cy) = (17, y + 7);
+                    a.draw(&Polygon::new(
+                        vec![(cx, cy - 5), (cx + 5, cy), (cx, cy + 5), (cx - 5, cy)],
+                        PUBLISHED.filled(),
+                    ))
+                    .map_err(err)
+                }
                 Some(k) => {
                     let (c, wdt) = match k {
                         LineKind::Refit => (BLACK, 2),
                         LineKind::Published => (PUBLISHED, 2),
                         LineKind::GroupCurve(g) | LineKind::GroupMean(g) => (group_color(g), 2),
-                        LineKind::Reference => (RGBColor(90, 90, 90), 1),
+                        LineKind::Reference | LineKind::Constraint => (RGBColor(90, 90, 90), 1),
                     };
                     a.draw(&PathElement::new(
                         vec![(8, mid), (26, mid)],

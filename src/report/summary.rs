@@ -66,6 +66,39 @@ fn inference_paragraph(records: &[FitRecord]) -> String {
     )
 }
 
+/// For a relation whose paper gives no value for some coefficients (Ko–Badler's α: only their
+/// ranges), the "published" fit is of a reference curve with those at the relation's reference
+/// values: its words (`None` when the paper gives every value).
+fn reference_words(r: &FitRecord) -> Option<String> {
+    // Only the relation's own coefficients the paper cites no value for (not per-subject
+    // levels, which the published curve has none of).
+    let rel = crate::relations::by_id(&r.relation).ok()?;
+    let specs: Vec<&crate::relations::ParameterSpec> = r
+        .coefficients
+        .iter()
+        .filter(|c| c.published.is_none())
+        .filter_map(|c| {
+            rel.parameters()
+                .iter()
+                .find(|s| s.name == c.name && !s.cited)
+        })
+        .collect();
+    if specs.is_empty() {
+        return None;
+    }
+    let refs: Vec<String> = specs
+        .iter()
+        .map(|s| format!("{} = {}", s.name, g(s.published)))
+        .collect();
+    let names: Vec<&str> = specs.iter().map(|s| s.name).collect();
+    Some(format!(
+        "the paper's values with {}: it gives only ranges for {}, so this is a reference, not \
+         a published curve",
+        refs.join(", "),
+        names.join(", ")
+    ))
+}
+
 /// Renders the summary of `records` (in the given order). `failures` lists relations that could
 /// not be fitted, with the reason.
 /// `figures` holds, per relation id, the plots written for it (see
@@ -90,10 +123,18 @@ pub fn render_summary(
         "| relation | n | subjects | r² | published r² | rmse | published rmse | LOSO rmse |"
     );
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|");
+    let mut footnotes = Vec::new();
     for r in records {
+        let mark = match reference_words(r) {
+            Some(w) => {
+                footnotes.push(format!("† `{}`: {w}.", r.relation));
+                "†"
+            }
+            None => "",
+        };
         let _ = writeln!(
             s,
-            "| [`{}`](#{}) | {} | {} | {:.4} | {:.4} | {} | {} | {} |",
+            "| [`{}`](#{}) | {} | {} | {:.4} | {:.4}{mark} | {} | {}{mark} | {} |",
             r.relation,
             r.relation,
             r.n,
@@ -111,6 +152,9 @@ pub fn render_summary(
             "| `{id}` | — | — | not fitted: {} | | | | |",
             why.replace('|', "/")
         );
+    }
+    if !footnotes.is_empty() {
+        let _ = writeln!(s, "\n{}", footnotes.join("\n"));
     }
     for r in records {
         let _ = writeln!(s, "\n## {}\n", r.relation);
@@ -134,9 +178,14 @@ pub fn render_summary(
             r.loso_rmse.map_or("n/a".into(), g),
             r.loso_note
         );
+        let reference = reference_words(r);
         let _ = writeln!(
             s,
-            "Published coefficients on the same rows: r² = {:.5}, rmse = {}.\n",
+            "{} on the same rows: r² = {:.5}, rmse = {}.\n",
+            match &reference {
+                Some(w) => format!("Reference curve ({w})"),
+                None => "Published coefficients".to_string(),
+            },
             r.published_fit.r2,
             g(r.published_fit.rmse)
         );
@@ -187,7 +236,12 @@ pub fn render_summary(
             if let Some(h) = &c.held {
                 parts.push(h.clone());
             }
-            if let Some(f) = &c.flag {
+            // A flag the held note already starts with is not said twice.
+            if let Some(f) = c
+                .flag
+                .as_ref()
+                .filter(|f| !c.held.as_ref().is_some_and(|h| h.starts_with(f.as_str())))
+            {
                 parts.push(format!("**{f}**"));
             }
             if let Some(b) = c.ci95_bootstrap {
@@ -216,7 +270,15 @@ pub fn render_summary(
             );
         }
         if !r.derived.is_empty() {
-            let _ = writeln!(s, "\n| derived | published | refit |\n|---|---:|---:|");
+            let _ = writeln!(
+                s,
+                "\n| derived | {} | refit |\n|---|---:|---:|",
+                if reference.is_some() {
+                    "reference (see above)"
+                } else {
+                    "published"
+                }
+            );
             for d in &r.derived {
                 let _ = writeln!(
                     s,
