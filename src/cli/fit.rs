@@ -203,8 +203,14 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             .get(o.refit.response().symbol)
             .cloned()
             .unwrap_or_default();
+        // Ko–Badler's α have no published values: its "published" curve is a reference.
+        let against = if crate::report::summary::reference_words(r).is_some() {
+            "paper's reference curve"
+        } else {
+            "published"
+        };
         println!(
-            "{}: n = {}, r² = {:.4} (published {:.4}), rmse = {:.4} {} → {}",
+            "{}: n = {}, r² = {:.4} ({against} {:.4}), rmse = {:.4} {} → {}",
             r.relation,
             r.n,
             r.r2,

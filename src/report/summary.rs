@@ -69,7 +69,9 @@ fn inference_paragraph(records: &[FitRecord]) -> String {
 /// For a relation whose paper gives no value for some coefficients (Ko–Badler's α: only their
 /// ranges), the "published" fit is of a reference curve with those at the relation's reference
 /// values: its words (`None` when the paper gives every value).
-fn reference_words(r: &FitRecord) -> Option<String> {
+/// Where the "published" curve of `r` is only a reference (the paper gives no value for some of
+/// the relation's own coefficients, e.g. Ko–Badler's α, held at the values named here): why.
+pub fn reference_words(r: &FitRecord) -> Option<String> {
     // Only the relation's own coefficients the paper cites no value for (not per-subject
     // levels, which the published curve has none of).
     let rel = crate::relations::by_id(&r.relation).ok()?;
