@@ -513,6 +513,28 @@ impl Kinematics {
         p[self.vertical]
     }
 
+    /// The first time in frames `a..b` where the per-frame signal `s` crosses `level` (falling
+    /// through it, or rising), linearly interpolated between frames.
+    fn level_crossing(
+        &self,
+        s: &[f64],
+        level: f64,
+        falling: bool,
+        a: usize,
+        b: usize,
+    ) -> Option<f64> {
+        let last = s.len().min(self.time_s.len()).checked_sub(1)?;
+        let i = (a..b.min(last)).find(|&i| {
+            if falling {
+                s[i] >= level && s[i + 1] < level
+            } else {
+                s[i] <= level && s[i + 1] > level
+            }
+        })?;
+        let w = (level - s[i]) / (s[i + 1] - s[i]);
+        Some(self.time_s[i] + w.clamp(0.0, 1.0) / self.rate_hz)
+    }
+
     /// The frame nearest to time `t` (clamped to the valid range).
     pub fn frame_at(&self, t: f64) -> usize {
         let n = self.time_s.len();
@@ -808,17 +830,9 @@ impl Kinematics {
                     EventKind::HeelStrike => (&sh, opts.hs_speed_fraction * speed, true),
                     _ => (&st, opts.to_speed_fraction * speed, false),
                 };
-                let crossing = (a..b.min(n - 1)).find(|&i| {
-                    if falling {
-                        s[i] >= level && s[i + 1] < level
-                    } else {
-                        s[i] <= level && s[i + 1] > level
-                    }
-                });
-                if let Some(i) = crossing {
-                    let w = (level - s[i]) / (s[i + 1] - s[i]);
+                if let Some(time_s) = self.level_crossing(s, level, falling, a, b) {
                     out.push(GaitEvent {
-                        time_s: self.time_s[i] + w.clamp(0.0, 1.0) / self.rate_hz,
+                        time_s,
                         side,
                         kind,
                         source: EventSource::FootSpeed,
@@ -832,17 +846,9 @@ impl Kinematics {
                     _ => continue,
                 };
                 let (a, b) = (self.frame_at(e.time_s + lo), self.frame_at(e.time_s + hi));
-                let crossing = (a..b.min(n - 1)).find(|&i| {
-                    if falling {
-                        s[i] >= level && s[i + 1] < level
-                    } else {
-                        s[i] <= level && s[i + 1] > level
-                    }
-                });
-                if let Some(i) = crossing {
-                    let w = (level - s[i]) / (s[i + 1] - s[i]);
+                if let Some(time_s) = self.level_crossing(s, level, falling, a, b) {
                     out.push(GaitEvent {
-                        time_s: self.time_s[i] + w.clamp(0.0, 1.0) / self.rate_hz,
+                        time_s,
                         side,
                         kind: e.kind,
                         source: EventSource::FootSpeed,
