@@ -10,37 +10,12 @@
 //! other ignored tests. Without a browser it fails, saying so: it never skips.
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader};
-use std::net::TcpStream;
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use tungstenite::stream::MaybeTlsStream;
-use tungstenite::{Message, WebSocket};
-
-/// Longest wait for any one thing (a hang guard, not a performance bound).
-const PATIENCE: Duration = Duration::from_secs(90);
-
-struct Killed(Child);
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn chromium() -> PathBuf {
-    let p = std::env::var_os("GAITFIT_CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    assert!(
-        p.exists(),
-        "{} not found: install Debian's chromium (`apt-get install -y chromium`, as .ci/run does) \
-         or set GAITFIT_CHROMIUM",
-        p.display()
-    );
-    p
-}
+#[path = "common/browser.rs"]
+mod browser;
+use browser::{chromium, start_chromium, Cdp, Killed, PATIENCE};
 
 /// Starts `gaitfit studio --port 0` and returns it with the address it printed.
 fn start_studio() -> (Killed, String) {
@@ -67,133 +42,13 @@ fn start_studio() -> (Killed, String) {
     (Killed(child), url)
 }
 
-/// Starts headless chromium with the machine's flags and returns it with its DevTools URL.
-fn start_chromium(profile: &Path) -> (Killed, String) {
-    let mut child = Command::new(chromium())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--remote-debugging-port=0",
-            "--window-size=1400,1000",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .arg("about:blank")
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start chromium");
-    let err = child.stderr.take().expect("chromium stderr");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(err).lines().map_while(Result::ok) {
-            if let Some(i) = line.find("ws://") {
-                let _ = tx.send(line[i..].trim().to_string());
-            }
-        }
-    });
-    let ws = rx
-        .recv_timeout(PATIENCE)
-        .expect("chromium printed no DevTools address");
-    (Killed(child), ws)
+/// The studio page's own waits and keys.
+trait StudioCdp {
+    fn settle(&mut self, seq: u64) -> Value;
+    fn key(&mut self, key: &str, code: u32);
 }
 
-struct Cdp {
-    ws: WebSocket<MaybeTlsStream<TcpStream>>,
-    next: u64,
-    session: Option<String>,
-    console_errors: Vec<String>,
-}
-
-impl Cdp {
-    fn connect(url: &str) -> Cdp {
-        let (ws, _) = tungstenite::connect(url).expect("connect to DevTools");
-        if let MaybeTlsStream::Plain(s) = ws.get_ref() {
-            s.set_read_timeout(Some(PATIENCE)).expect("timeout");
-        }
-        Cdp {
-            ws,
-            next: 1,
-            session: None,
-            console_errors: Vec::new(),
-        }
-    }
-
-    fn note_event(&mut self, v: &Value) {
-        let p = &v["params"];
-        match v["method"].as_str() {
-            Some("Runtime.consoleAPICalled")
-                if matches!(p["type"].as_str(), Some("error" | "assert")) =>
-            {
-                self.console_errors
-                    .push(format!("console.{}: {}", p["type"], p["args"]));
-            }
-            Some("Runtime.exceptionThrown") => {
-                self.console_errors
-                    .push(format!("exception: {}", p["exceptionDetails"]));
-            }
-            Some("Log.entryAdded") if p["entry"]["level"] == "error" => {
-                self.console_errors
-                    .push(format!("log: {}", p["entry"]["text"]));
-            }
-            _ => {}
-        }
-    }
-
-    fn call(&mut self, method: &str, params: Value) -> Value {
-        let id = self.next;
-        self.next += 1;
-        let mut msg = json!({"id": id, "method": method, "params": params});
-        if let Some(s) = &self.session {
-            msg["sessionId"] = json!(s);
-        }
-        self.ws
-            .send(Message::text(msg.to_string()))
-            .expect("send to DevTools");
-        loop {
-            let m = self.ws.read().expect("read from DevTools");
-            let Message::Text(t) = m else { continue };
-            let v: Value = serde_json::from_str(t.as_str()).expect("DevTools JSON");
-            if v["id"] == json!(id) {
-                assert!(v.get("error").is_none(), "{method}: {}", v["error"]);
-                return v["result"].clone();
-            }
-            if v.get("method").is_some() {
-                self.note_event(&v);
-            }
-        }
-    }
-
-    fn eval(&mut self, js: &str) -> Value {
-        let r = self.call(
-            "Runtime.evaluate",
-            json!({"expression": js, "returnByValue": true, "awaitPromise": true}),
-        );
-        assert!(
-            r.get("exceptionDetails").is_none(),
-            "{js}: {}",
-            r["exceptionDetails"]
-        );
-        r["result"]["value"].clone()
-    }
-
-    fn wait_for(&mut self, what: &str, js: &str) -> Value {
-        let t0 = Instant::now();
-        loop {
-            let v = self.eval(js);
-            if !(v.is_null() || v == json!(false)) {
-                return v;
-            }
-            assert!(t0.elapsed() < PATIENCE, "waited {PATIENCE:?} for {what}");
-            std::thread::sleep(Duration::from_millis(25));
-        }
-    }
-
+impl StudioCdp for Cdp {
     /// Waits until the page has applied an answer after `seq` and has nothing queued.
     fn settle(&mut self, seq: u64) -> Value {
         self.wait_for(
@@ -295,16 +150,7 @@ fn studio_in_chromium() {
         "Browser.setDownloadBehavior",
         json!({"behavior": "allow", "downloadPath": downloads.display().to_string()}),
     );
-    let target = cdp.call("Target.createTarget", json!({"url": "about:blank"}));
-    let attached = cdp.call(
-        "Target.attachToTarget",
-        json!({"targetId": target["targetId"], "flatten": true}),
-    );
-    cdp.session = attached["sessionId"].as_str().map(String::from);
-    cdp.call("Runtime.enable", json!({}));
-    cdp.call("Log.enable", json!({}));
-    cdp.call("Page.enable", json!({}));
-    cdp.call("Page.navigate", json!({"url": url}));
+    cdp.open(&url);
     cdp.wait_for(
         "the page to load and draw its first run",
         "window.studio && window.studio.ready",
