@@ -318,8 +318,12 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         }
         None => (Vec::new(), Vec::new(), Vec::new()),
     };
+    // Walk or run: the user's --gait, a reader's data-based decision (a C3D's measured events,
+    // a treadmill data set's metadata), else the data here: the plates' events where they saw
+    // both kinds, the markers' (Zeni) otherwise. Never the file name (issue 21).
     let walking = match opts.gait.or(trial.gait) {
         Some(g) => g == Gait::Walk,
+        None if has_both_kinds(&fr.events) => looks_like_walking(&fr.events),
         None => looks_like_walking(&zc),
     };
     let fs = match &kin {

@@ -35,7 +35,6 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Trial, IngestError> {
     let mut trial = Trial::new(path, name);
     trial.plates = plates;
     trial.notes = notes;
-    super::mot::gait_from_name(&mut trial);
     finish(&mut trial, opts, None);
     Ok(trial)
 }

@@ -22,7 +22,7 @@ use super::frame_detect;
 use super::text::{self, Num};
 use super::types::{ForcePlate, Trial};
 use super::{finish, hamner, IngestError, ReadOptions};
-use crate::gait::{Gait, Side};
+use crate::gait::Side;
 use std::path::Path;
 
 /// A MOT/STO table in SI units (angles in radians when the file says `inDegrees=yes`).
@@ -457,30 +457,8 @@ pub fn parse(bytes: &[u8], path: &Path, opts: &ReadOptions) -> Result<Trial, Ing
     if opts.companions {
         hamner::apply(&mut trial, path, opts)?;
     }
-    gait_from_name(&mut trial);
     finish(&mut trial, opts, None);
     Ok(trial)
-}
-
-/// Sets `trial.gait` from its name (`run` → running, `walk` → walking) when not yet known.
-pub(crate) fn gait_from_name(trial: &mut Trial) {
-    if trial.gait.is_some() {
-        return;
-    }
-    let n = trial.name.to_ascii_lowercase();
-    let g = if n.contains("run") {
-        Some(Gait::Run)
-    } else if n.contains("walk") {
-        Some(Gait::Walk)
-    } else {
-        None
-    };
-    if let Some(g) = g {
-        trial.gait = Some(g);
-        trial
-            .notes
-            .push(format!("gait: {g} (from the file name {:?})", trial.name));
-    }
 }
 
 #[cfg(test)]

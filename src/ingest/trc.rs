@@ -68,7 +68,6 @@ pub fn read(path: &Path, opts: &ReadOptions) -> Result<Trial, IngestError> {
         attach_companion_plates(&mut trial, path, opts)?;
         hamner::apply(&mut trial, path, opts)?;
     }
-    super::mot::gait_from_name(&mut trial);
     finish(&mut trial, opts, None);
     Ok(trial)
 }
