@@ -13,7 +13,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use gaitfit::fit::ols::{ols, polynomial_design, polynomial_fit, LinearFit, LinearProblem};
-use gaitfit::fit::stats::lre;
+use gaitfit::fit::stats::{lre, min_lre};
 use gaitfit::fit::strd::{read, StrdDataset};
 use gaitfit::fit::FitError;
 use nalgebra::{DMatrix, DVector};
@@ -31,17 +31,6 @@ impl Lre {
     fn min(&self) -> f64 {
         self.coef.min(self.sd).min(self.resid_sd).min(self.r2)
     }
-}
-
-fn min_lre(computed: &[f64], certified: &[f64]) -> f64 {
-    computed
-        .iter()
-        .zip(certified)
-        .map(|(&c, &x)| lre(c, x))
-        .fold(
-            f64::INFINITY,
-            |a, b| if b.is_nan() { f64::NAN } else { a.min(b) },
-        )
 }
 
 fn score(fit: &LinearFit, d: &StrdDataset) -> Lre {

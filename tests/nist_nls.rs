@@ -15,7 +15,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use gaitfit::fit::nonlinear::{nls, Model, NlsOptions, NonlinearFit, Rows};
-use gaitfit::fit::stats::lre;
+use gaitfit::fit::stats::{lre, min_lre};
 use gaitfit::fit::strd::{read, StrdDataset};
 
 #[derive(Clone, Copy, Debug)]
@@ -142,17 +142,6 @@ impl Model for Numeric {
     fn value(&self, x: &[f64], b: &[f64]) -> f64 {
         Analytic(self.0).value(x, b)
     }
-}
-
-fn min_lre(computed: &[f64], certified: &[f64]) -> f64 {
-    computed
-        .iter()
-        .zip(certified)
-        .map(|(&c, &x)| lre(c, x))
-        .fold(
-            f64::INFINITY,
-            |a, b| if b.is_nan() { f64::NAN } else { a.min(b) },
-        )
 }
 
 struct Row {

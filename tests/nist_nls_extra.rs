@@ -19,7 +19,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use gaitfit::fit::nonlinear::{nls, Model, NlsOptions, Rows};
-use gaitfit::fit::stats::lre;
+use gaitfit::fit::stats::{lre, min_lre};
 use gaitfit::fit::strd::read;
 use std::f64::consts::PI;
 
@@ -333,17 +333,6 @@ fn sets() -> Vec<Nist> {
             },
         },
     ]
-}
-
-fn min_lre(computed: &[f64], certified: &[f64]) -> f64 {
-    computed
-        .iter()
-        .zip(certified)
-        .map(|(&c, &x)| lre(c, x))
-        .fold(
-            f64::INFINITY,
-            |a, b| if b.is_nan() { f64::NAN } else { a.min(b) },
-        )
 }
 
 #[test]

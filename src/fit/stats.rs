@@ -98,6 +98,28 @@ pub fn lre(computed: f64, certified: f64) -> f64 {
     }
 }
 
+/// The smallest [`lre`] over pairs of computed and certified values (NaN if any computed value
+/// is not finite): the figure NIST StRD results are judged by.
+///
+/// ```
+/// use gaitfit::fit::stats::min_lre;
+/// assert!((min_lre(&[1.000001, 2.0], &[1.0, 2.0]) - 6.0).abs() < 1e-6);
+/// assert!(min_lre(&[f64::NAN, 2.0], &[1.0, 2.0]).is_nan());
+/// ```
+pub fn min_lre(computed: &[f64], certified: &[f64]) -> f64 {
+    computed
+        .iter()
+        .zip(certified)
+        .map(|(&c, &x)| lre(c, x))
+        .fold(f64::INFINITY, |a, b| {
+            if b.is_nan() || a.is_nan() {
+                f64::NAN
+            } else {
+                a.min(b)
+            }
+        })
+}
+
 /// Centred r² = `1 − rss / Σ wᵢ (yᵢ − ȳ_w)²` (unit weights when `weights` is `None`).
 pub fn r2_centred(y: &[f64], rss: f64, weights: Option<&[f64]>) -> f64 {
     let (sw, swy) = y
