@@ -263,3 +263,14 @@ fn committed_fit_is_the_default_and_winter_leg_length_matches() {
         .unwrap();
     assert_eq!(ll[row], WINTER_TABLE_LEG_LENGTH);
 }
+
+/// The relation reads sl* and μ* from the bundled prototype file itself (no generator import):
+/// they must be the values the generator's prototype carries.
+#[test]
+fn published_values_are_the_prototypes() {
+    let p = gaitfit::generator::generalize::prototype::Prototype::bundled();
+    let r = KbMu::published();
+    assert_eq!(r.mu_star(), p.mu_star);
+    assert_eq!(r.sl_star(), p.walk.step_length());
+    assert_eq!(r.alpha(), [0.0; 4]);
+}

@@ -27,6 +27,7 @@ use super::bounded::BoxSolution;
 use super::design::Layout;
 use super::pipeline::Prepared;
 use super::FitError;
+use crate::fit::forms::Fitting;
 use crate::fit::record::{BoundedRecord, DerivedRecord};
 use crate::relations::{ParamKind, Relation};
 use std::sync::atomic::{AtomicUsize, Ordering};

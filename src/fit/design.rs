@@ -20,7 +20,8 @@ use super::inference::{
     bm_df, cr1_factor, cr2_clusters, inverse_factor, meat, Cluster, Cr2Cluster, SeMethod,
 };
 use super::pipeline::Prepared;
-use crate::relations::{NormalEquations, Observation, ParamKind, Relation};
+use crate::fit::forms::{Fitting, NormalEquations};
+use crate::relations::{Observation, ParamKind, Relation};
 use nalgebra::{DMatrix, DVector};
 
 /// Most basis columns a relation may have (the fixed-size row buffers).

@@ -19,6 +19,7 @@ use thiserror::Error;
 pub mod bounded;
 pub mod constrained;
 pub mod design;
+pub mod forms;
 pub mod inference;
 pub mod nonlinear;
 pub mod ols;

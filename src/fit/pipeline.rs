@@ -55,6 +55,7 @@ use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
 };
 use super::FitError;
+use crate::fit::forms::Fitting;
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Observation, ParamKind, Relation};
 use profile::{

@@ -46,10 +46,9 @@
 //! ```
 use super::{
     expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
-    Observation, ParamKind, ParameterSpec, Plan, Rejection, Relation, RelationError, Variable,
+    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
 };
 use crate::events::Gait;
-use crate::fit::nonlinear::Model;
 use crate::ingest::trials::FieldValues;
 use crate::units::Quantity;
 use std::collections::BTreeMap;
@@ -78,9 +77,9 @@ pub const NAMES: [&str; 10] = [
     "sl_star", "ll_star",
 ];
 /// Index of sl* among the parameters.
-const SL_STAR: usize = 8;
+pub const SL_STAR: usize = 8;
 /// Index of ll(S*) among the parameters.
-const LL_STAR: usize = 9;
+pub const LL_STAR: usize = 9;
 /// Names of the four outputs.
 const OUTPUT_NAMES: [&str; 4] = ["mu1", "mu2", "mu3", "mu4"];
 const OUTPUT_LABELS: [&str; 4] = [
@@ -111,13 +110,33 @@ fn sign(i: usize) -> f64 {
     }
 }
 
+/// The two numbers of the bundled prototype (`data/prototype_winter.json`, Winter's walk) that
+/// the published relation uses: its step length sl* and its μ₁*…μ₄*. Read from the same file
+/// the generator's `Prototype::bundled` reads (tests/kb_mu_fit.rs checks they agree), so the
+/// relation needs no generator import.
+#[derive(serde::Deserialize)]
+struct BundledPrototype {
+    step_length_m: f64,
+    mu_star_rad: [f64; 4],
+}
+
+/// The bundled prototype's sl* and μ* (the file is committed; parsing it cannot fail unless the
+/// repository itself is broken, which `tests/kb_prototype.rs` would report first).
+fn bundled_prototype() -> BundledPrototype {
+    const TEXT: &str = include_str!("../../data/prototype_winter.json");
+    match serde_json::from_str(TEXT) {
+        Ok(p) => p,
+        Err(e) => panic!("the bundled prototype data/prototype_winter.json is broken: {e}"),
+    }
+}
+
 /// The parameter table: α not published (the paper gives none; 0, the similarity assumption
 /// alone, is the reference value the published relation uses), μ* and sl* the bundled
 /// prototype's. Built once (it reads the bundled prototype).
 fn params() -> &'static [ParameterSpec] {
     static P: OnceLock<Vec<ParameterSpec>> = OnceLock::new();
     P.get_or_init(|| {
-        let proto = crate::generator::generalize::prototype::Prototype::bundled();
+        let proto = bundled_prototype();
         let alpha = |name: &'static str, description: &'static str| ParameterSpec {
             name,
             unit: "rad/m",
@@ -130,7 +149,7 @@ fn params() -> &'static [ParameterSpec] {
         let star = |k: usize, description: &'static str| ParameterSpec {
             name: NAMES[4 + k],
             unit: "rad",
-            published: proto.mu_star[k],
+            published: proto.mu_star_rad[k],
             cited: true,
             kind: ParamKind::Linear,
             description,
@@ -172,7 +191,7 @@ fn params() -> &'static [ParameterSpec] {
             ParameterSpec {
                 name: "sl_star",
                 unit: "m",
-                published: proto.walk.step_length(),
+                published: proto.step_length_m,
                 cited: true,
                 kind: ParamKind::Breakpoint,
                 description: "the bundled prototype's step length",
@@ -378,48 +397,12 @@ impl Relation for KbMu {
     fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
         Some(linear_gradient(self, p, x))
     }
-    fn plan(&self, _obs: &[Observation]) -> Plan {
-        let mut held = vec![None; NAMES.len()];
-        held[SL_STAR] = Some(
-            "held at the bundled prototype's step length: not identifiable beside free μ*".into(),
-        );
-        held[LL_STAR] =
-            Some("held at Winter's leg length as the trials tables measure it (defines x)".into());
-        Plan {
-            held,
-            search: vec![None; NAMES.len()],
-        }
-    }
     fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
         Box::new(KbMu {
             values: values.to_vec(),
             levels,
             range: FittedRange::default(),
         })
-    }
-}
-
-/// The μ-function model for [`crate::fit::nonlinear::nls`]: row = (x, index), θ = (α₁…α₄,
-/// μ₁*…μ₄*); an independent formulation used by the tests.
-#[derive(Debug, Clone, Copy)]
-pub struct MuModel {
-    /// sl*, m.
-    pub sl_star: f64,
-}
-
-impl Model for MuModel {
-    fn n_params(&self) -> usize {
-        8
-    }
-    fn value(&self, x: &[f64], t: &[f64]) -> f64 {
-        let i = x[1] as usize;
-        sign(i) * t[i] * (x[0] - self.sl_star) + t[4 + i]
-    }
-    fn gradient(&self, x: &[f64], _t: &[f64], out: &mut [f64]) {
-        out.iter_mut().for_each(|g| *g = 0.0);
-        let i = x[1] as usize;
-        out[i] = sign(i) * (x[0] - self.sl_star);
-        out[4 + i] = 1.0;
     }
 }
 
@@ -459,14 +442,5 @@ mod tests {
             assert!((r.predict(&x) - want).abs() < 1e-15);
             assert!((r.mu(i, 0.63) - want).abs() < 1e-15);
         }
-    }
-
-    #[test]
-    fn published_values_are_the_prototypes() {
-        let p = crate::generator::generalize::prototype::Prototype::bundled();
-        let r = KbMu::published();
-        assert_eq!(r.mu_star(), p.mu_star);
-        assert_eq!(r.sl_star(), p.walk.step_length());
-        assert_eq!(r.alpha(), [0.0; 4]);
     }
 }

@@ -20,9 +20,8 @@
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
 use super::{
-    expect_id, linear_gradient, required, sorted_keys, Citation, CoefficientSet, Domain,
-    FittedRange, KeyRange, KeyScale, KeySums, NormalEquations, Observation, ParamKind,
-    ParameterSpec, Plan, Rejection, Relation, RelationError, SortedProfile, SubjectEffect,
+    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
+    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, SubjectEffect,
     Variable,
 };
 use crate::events::Gait;
@@ -275,15 +274,6 @@ impl Relation for RunSlV {
         d[2] = if x[0] > p[2] * r { p[1] * r * r } else { 0.0 };
         Some(d)
     }
-    fn plan(&self, obs: &[Observation]) -> Plan {
-        self.plan_sorted(&sorted_keys(self, obs))
-    }
-    fn sorted_profile(&self) -> Option<&dyn SortedProfile> {
-        Some(self)
-    }
-    fn breakpoint_null(&self, _i: usize) -> Option<f64> {
-        Some(f64::INFINITY)
-    }
     fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
         Box::new(RunSlV {
             values: values.to_vec(),
@@ -294,119 +284,5 @@ impl Relation for RunSlV {
     fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {
         let r = RunSlV::new(p[0], p[1], p[2]);
         vec![("sl_norm(h=1.8)".to_string(), r.sl_norm(1.8, 0.0), "m")]
-    }
-}
-
-/// Feature slots of the sorted profile: below the plateau the regressor is z₀ = v·r, on it
-/// v_norm·q with q = r² (r = √(h/1.8)).
-mod feat {
-    pub const ONE: usize = 0;
-    pub const Z: usize = 1;
-    pub const ZZ: usize = 2;
-    pub const Y: usize = 3;
-    pub const ZY: usize = 4;
-    pub const Q: usize = 5;
-    pub const QQ: usize = 6;
-    pub const QY: usize = 7;
-    pub const YY: usize = 8;
-    pub const N: usize = 9;
-}
-
-impl SortedProfile for RunSlV {
-    /// The height-normalised speed u = v/√(h/1.8): a row is on the plateau when u > v_norm.
-    fn key(&self, x: &[f64]) -> f64 {
-        x[0] / (x[1] / REFERENCE_HEIGHT_M).sqrt()
-    }
-    fn n_features(&self) -> usize {
-        feat::N
-    }
-    fn features(&self, _scale: &KeyScale, _centre: f64, o: &Observation, out: &mut [f64]) {
-        let r = (o.x[1] / REFERENCE_HEIGHT_M).sqrt();
-        let (z, q, y) = (o.x[0] * r, r * r, o.y);
-        out[feat::ONE] = 1.0;
-        out[feat::Z] = z;
-        out[feat::ZZ] = z * z;
-        out[feat::Y] = y;
-        out[feat::ZY] = z * y;
-        out[feat::Q] = q;
-        out[feat::QQ] = q * q;
-        out[feat::QY] = q * y;
-        out[feat::YY] = y * y;
-    }
-    fn normal_equations(
-        &self,
-        p: &[f64],
-        free: &[bool],
-        _scale: &KeyScale,
-        sums: &dyn KeySums,
-    ) -> NormalEquations {
-        let t = p[2];
-        // Rows with u ≤ v_norm use z₀; the others v_norm·q (equal at u = v_norm).
-        let lo = sums.range(KeyRange::below(t, true), t);
-        let hi = sums.range(KeyRange::above(t, false), t);
-        let (mut sz, mut szz, mut szy) = (lo[feat::Z], lo[feat::ZZ], lo[feat::ZY]);
-        if hi[feat::ONE] != 0.0 {
-            sz += t * hi[feat::Q];
-            szz += t * t * hi[feat::QQ];
-            szy += t * hi[feat::QY];
-        }
-        let tot = |j: usize| lo[j] + hi[j];
-        let raw = NormalEquations {
-            nb: 2,
-            xtx: vec![tot(feat::ONE), sz, sz, szz],
-            xty: vec![tot(feat::Y), szy],
-            yty: tot(feat::YY),
-        };
-        NormalEquations::hold_raw(&raw, &free[..2], &p[..2])
-    }
-    fn plan_sorted(&self, u: &[f64]) -> Plan {
-        // At least 3 distinct normalised speeds on each side of any trial breakpoint.
-        let (held, search) = if u.len() >= 8 {
-            (None, Some((u[2], u[u.len() - 3])))
-        } else {
-            (
-                Some(format!(
-                    "needs at least 8 distinct speeds to locate the plateau (have {})",
-                    u.len()
-                )),
-                None,
-            )
-        };
-        Plan {
-            held: vec![None, None, held],
-            search: vec![None, None, search],
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sorted_normal_equations_match_the_basis_rows() {
-        let obs: Vec<Observation> = (0..300)
-            .map(|i| {
-                let v = 100.0 + 1.3 * (i % 290) as f64;
-                let h = 1.6 + 0.05 * (i % 7) as f64;
-                Observation {
-                    x: [v, h, 0.0, 0.0],
-                    y: sl(&[0.14, 0.0046, 400.0], 0.0, v, h) + 0.01 * ((i % 3) as f64 - 1.0),
-                }
-            })
-            .collect();
-        let r = RunSlV::published();
-        for t in [150.0, 283.7, 400.0, 1e4, f64::INFINITY] {
-            for free in [[true, true], [false, true], [true, false], [false, false]] {
-                let p = [0.1394, 0.00465, t];
-                crate::relations::sorted_check::check(
-                    &r,
-                    &obs,
-                    &p,
-                    &[free[0], free[1], true],
-                    1e-11,
-                );
-            }
-        }
     }
 }

@@ -29,14 +29,14 @@
 //! - Two breakpoints are profiled by coordinate descent.
 use super::Prepared;
 use crate::fit::design::{solve_rows, Layout, SubjectSums, Totals};
+use crate::fit::forms::{
+    FeatureSums, Fitting, KeyRange, KeyScale, KeySums, SortedProfile, MAX_PROFILE_FEATURES,
+};
 use crate::fit::nonlinear::minimize_1d;
 use crate::fit::prec::MIN1D_GRID;
 use crate::fit::record::BreakpointRecord;
 use crate::fit::FitError;
-use crate::relations::{
-    FeatureSums, KeyRange, KeyScale, KeySums, Observation, ParamKind, Relation, SortedProfile,
-    MAX_PROFILE_FEATURES,
-};
+use crate::relations::{Observation, ParamKind, Relation};
 use nalgebra::DVector;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -1177,7 +1177,9 @@ mod tests {
     #[test]
     fn the_lazy_tree_over_all_rows_equals_the_eager_one() {
         let rel = RunTflightSf::published();
-        let form = rel.sorted_profile().expect("sorted form");
+        let form = (&rel as &dyn Relation)
+            .sorted_profile()
+            .expect("sorted form");
         let mut prep = Prepared::default();
         for i in 0..3000usize {
             let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
