@@ -47,8 +47,7 @@ pub const RUN_ATTRS: [AttrDef; 3] = [
         unit: "s",
         step: 0.005,
         range: (-0.15, 0.15),
-        doc:
-            "added to the flight time of the relation run-tflight-sf (eqs. 4–5); H follows (eq. 3)",
+        doc: "added to the flight time of the relation run-tflight-sf (eqs. 4–5), driven as the flight time (case I); H reported (eq. 3)",
     },
     AttrDef {
         name: "bounciness_deg",
@@ -176,7 +175,14 @@ pub fn drive(
 
 /// RUNNER's parameters at speed `v` with the calibration `theta` applied: the natural step
 /// length (eq. 2) plus the offset, speed held; the relation's flight time at the resulting
-/// frequency plus the offset, converted to the flight height H by eq. 3.
+/// frequency (eqs. 4–5) plus the offset, driven as the flight time itself (case I of §3.2),
+/// with the flight height H of eq. 3 only reported.
+///
+/// The flight is not handed to RUNNER as H (case II): with the toe-off leg of eq. 8 the pelvis
+/// takes off higher the longer the flight, so H is not monotone in the flight time and one H
+/// has several flight times (Hamner subject01 at 3 m/s, refitted relations: H = 0.0070 m for
+/// 0.080 s and for 0.196 s of flight; case II's Newton–Raphson found the 0.196 s one, and the
+/// generated contact was 0.17 s instead of the planned 0.28 s).
 pub fn run_params(
     model: &RunModel,
     attrs: &RunAttributes,
@@ -191,8 +197,9 @@ pub fn run_params(
     let tf = (model.relations.flight_time(p.step_freq, 0.0) + theta[1]).max(0.01);
     let (hgt, _) =
         model.steady_flight(v, p.step_length, p.step_freq, FlightSpec::Time(tf), attrs)?;
-    p.locks.set(Param::StepLength, true);
-    p = model.set(&p, Param::FlightHeight, hgt, attrs)?;
+    p.flight_time = tf;
+    p.flight_height = hgt;
+    p.flight_from_height = false;
     p.locks = Default::default();
     Ok(p)
 }
