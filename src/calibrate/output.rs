@@ -302,7 +302,9 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
          steps per condition, measured by the same event pipeline as the trials. Residual = \
          generated − measured; stage <i>relations</i>: the relations with the generators' default \
          attributes; stage <i>calibrated</i>: the per-subject attributes found by Gauss–Newton on \
-         the weighted residual objective (weights: the measured step-to-step SD).</p>",
+         the weighted residual objective (weights: the measured step-to-step SD; cadence, step \
+         length, flight or double support and pelvis excursion — the contact time is reported, not \
+         fitted, being the step time and the flight or double support together).</p>",
         esc(&cal.relations_source),
         cal.drive.fps,
         cal.drive.steps

@@ -1,13 +1,21 @@
 //! The calibration objective and its Gauss–Newton minimisation (argmin's `GaussNewton`).
 //!
 //! Objective, per subject: `½ Σ_c Σ_q ((g_cq(θ) − m_cq) / σ_cq)²` over the subject's
-//! conditions c (trials) and quantities q — cadence, step length, contact time, flight time
-//! (runs) or double support (walks), pelvis vertical excursion — where `g` is the quantity
+//! conditions c (trials) and quantities q — cadence, step length, flight time (runs) or double
+//! support (walks), pelvis vertical excursion — where `g` is the quantity
 //! measured on the generated motion and `m` on the measured trial. The weight `σ_cq` is the
 //! measured step-to-step standard deviation of the quantity in that trial (the subject's own
 //! variability), floored at the resolution of the measurement (0.5 steps/min, 5 mm, one
 //! generated frame, 0.5 % of the cycle, 2 mm). A quantity the generated motion does not show
 //! (no flight detected, a failed generation) enters as a residual of 10 σ.
+//!
+//! The contact (stance) time is reported but not fitted: it is not a quantity of its own but
+//! the step time and the flight or double support together (run: contact = 1/sf − t_flight;
+//! walk: stance = t_cycle/2 + t_ds), so fitting it counts the cadence's residual a second
+//! time, in the flight or double support's place. With it in the objective, Schreiber 2014001
+//! (C4, C5), whose cadence one step-length offset cannot fit at both speeds (+1.0 and
+//! −2.8 steps/min), had its double support pushed to +1.4/+1.0 % of the cycle to make up the
+//! contact the cadence missed.
 //!
 //! The Jacobian is by forward differences (steps in [`super::drive::AttrDef::step`]); the
 //! standard errors are those of the Gauss–Newton covariance `s² (JᵀJ)⁻¹`, `s²` the residual
@@ -46,6 +54,10 @@ pub struct Stage {
     /// Generator notes (deduplicated).
     pub notes: Vec<String>,
 }
+
+/// The quantities the objective fits (indices in [`QUANTITIES`]): all but the contact time,
+/// which the cadence and the flight or double support determine (see the module docs).
+pub const FITTED: [usize; 4] = [0, 1, 3, 4];
 
 /// The value of quantity `q` (index in [`QUANTITIES`]) of a measurement.
 pub fn value(m: &Measurement, q: usize) -> Option<f64> {
@@ -91,7 +103,7 @@ impl Problem<'_> {
     ) -> Problem<'a> {
         let mut terms = Vec::new();
         for (c, cond) in subject.conditions.iter().enumerate() {
-            for q in 0..QUANTITIES.len() {
+            for q in FITTED {
                 if let Some(m) = value(&cond.measured, q) {
                     let sd = cond.measured.quantities.sd[q].unwrap_or(0.0);
                     let s = sd.max(floor(q, subject.gait, opts.drive.fps));
