@@ -59,7 +59,8 @@ use crate::fit::forms::Fitting;
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Observation, ParamKind, Relation};
 use profile::{
-    confidence_set, profile, refit, whole_subjects, Members, Profiler, SortedRows, Source, Subset,
+    confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, Profiler,
+    SortedRows, Source, Subset,
 };
 
 mod profile;
@@ -1142,10 +1143,17 @@ pub fn fit_relation(
             // Folds are subject multisets: no pass over the training rows.
             Some(sr) if n_bp > 0 => {
                 use rayon::prelude::*;
+                // Folds' keys without a pass over the rows; with a per-subject column, their
+                // sums as exact downdates of sums shared by all folds (module profile::folds).
+                let fold_keys = FoldKeys::new(sr);
+                let engine = match bps[..] {
+                    [i] => plan.search[i].and_then(|r| FoldEngine::new(sr, &lay, &p, i, r)),
+                    _ => None,
+                };
                 (0..n_subj)
                     .into_par_iter()
                     .map(|s| {
-                        let fold = Subset::Subjects(sr, Members::AllBut(s));
+                        let fold = Subset::Fold(sr, &fold_keys, engine.as_ref(), s);
                         let q = refit(rel, &free, &p, fold)?;
                         Some(rows_of[s].iter().map(|&i| sq_err(&q, i)).collect())
                     })

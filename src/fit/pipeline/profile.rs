@@ -42,6 +42,9 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::sync::OnceLock;
 
+mod folds;
+pub(super) use folds::{FoldEngine, FoldKeys};
+
 /// Evaluations after which the exact search of a discrete breakpoint stops and keeps the best
 /// partition found (with a note): reached only by a profile that is flat over a great many
 /// partitions (no knot in the data).
@@ -592,6 +595,11 @@ pub(super) enum Source<'b> {
         members: Members<'b>,
         keys: &'b [f64],
     },
+    /// All subjects but `s`, from the folds' shared sums (module `folds`).
+    Fold {
+        engine: &'b FoldEngine<'b>,
+        s: usize,
+    },
 }
 
 /// Evaluates a relation's fit on some rows at trial breakpoints.
@@ -612,6 +620,7 @@ impl Profiler<'_> {
                 n_subj,
             } => solve_rows(self.rel, self.lay, p, prep, rows, subj_map, n_subj),
             Source::Sorted { sr, members, .. } => solve_sorted(sr, self.lay, p, members, None),
+            Source::Fold { engine, s } => engine.solve(p, s),
         }
     }
 
@@ -1041,6 +1050,14 @@ pub(super) enum Subset<'b> {
     Rows(&'b Prepared, &'b [usize]),
     /// Some subjects' rows.
     Subjects(&'b SortedRows<'b>, Members<'b>),
+    /// All subjects but one (a leave-one-subject-out fold): its keys from `FoldKeys`, its sums
+    /// from the engine when one applies.
+    Fold(
+        &'b SortedRows<'b>,
+        &'b FoldKeys,
+        Option<&'b FoldEngine<'b>>,
+        usize,
+    ),
 }
 
 /// Maps subject ids of a row subset to dense 0..S indices (order of first appearance).
@@ -1106,6 +1123,11 @@ pub(super) fn refit(
             plan = sr.ctx.form.plan_sorted(&keys);
             (n_subj, map) = (list.len(), Vec::new());
         }
+        Subset::Fold(sr, fk, _, s) => {
+            keys = fk.without(s);
+            plan = sr.ctx.form.plan_sorted(&keys);
+            (n_subj, map) = (sr.subj.len() - 1, Vec::new());
+        }
     }
     let mut free = free.to_vec();
     let mut search = plan.search.clone();
@@ -1128,6 +1150,16 @@ pub(super) fn refit(
             members,
             keys: &keys,
         },
+        Subset::Fold(sr, _, engine, s) => {
+            match engine.filter(|e| e.applies(&lay, p_start, &search)) {
+                Some(engine) => Source::Fold { engine, s },
+                None => Source::Sorted {
+                    sr,
+                    members: Members::AllBut(s),
+                    keys: &keys,
+                },
+            }
+        }
     };
     let pr = Profiler {
         rel,
