@@ -51,12 +51,61 @@ pub fn two_link(root: DVec3, target: DVec3, upper: f64, lower: f64, pole: DVec3)
     let cos_a = ((upper * upper + d * d - lower * lower) / (2.0 * upper * d)).clamp(-1.0, 1.0);
     let sin_a = (1.0 - cos_a * cos_a).sqrt();
     let middle = root + upper * (cos_a * e + sin_a * p);
-    let cos_k = ((upper * upper + lower * lower - d * d) / (2.0 * upper * lower)).clamp(-1.0, 1.0);
     TwoLink {
         middle,
         end: root + d * e,
         reached,
-        flexion: std::f64::consts::PI - cos_k.acos(),
+        flexion: flexion_for_span(upper, lower, d),
+    }
+}
+
+/// Flexion of the middle joint, rad (0 = straight), of a two-link chain (`upper`, `lower`) whose
+/// ends are `d` apart, by the law of cosines; `d` is clamped to the reachable range.
+pub fn flexion_for_span(upper: f64, lower: f64, d: f64) -> f64 {
+    let d = d.clamp((upper - lower).abs() + 1e-12, upper + lower);
+    std::f64::consts::PI
+        - ((upper * upper + lower * lower - d * d) / (2.0 * upper * lower))
+            .clamp(-1.0, 1.0)
+            .acos()
+}
+
+/// Distance between the ends of a two-link chain (`upper`, `lower`) with the middle joint flexed
+/// by `flexion` rad: the inverse of [`flexion_for_span`].
+pub fn span_for_flexion(upper: f64, lower: f64, flexion: f64) -> f64 {
+    (upper * upper + lower * lower + 2.0 * upper * lower * flexion.cos())
+        .max(0.0)
+        .sqrt()
+}
+
+/// The planar two-link chain from `root` to `end` (sagittal `(x, y)`, y up) with the middle joint
+/// bending forward (+x): `[θ, flexion]`, rad, the upper segment pointing along `(−sin θ, −cos θ)`
+/// from the root (KLAW's thigh angle θ3) and the middle joint's flexion ([`flexion_for_span`]).
+pub fn planar_two_link(root: [f64; 2], end: [f64; 2], upper: f64, lower: f64) -> [f64; 2] {
+    let dx = root[0] - end[0];
+    let dy = root[1] - end[1];
+    let d = dx
+        .hypot(dy)
+        .clamp((upper - lower).abs() + 1e-12, upper + lower);
+    let flexion = flexion_for_span(upper, lower, d);
+    // Angle at the root between the root–end line and the upper segment.
+    let cos_r = ((upper * upper + d * d - lower * lower) / (2.0 * upper * d)).clamp(-1.0, 1.0);
+    [dx.atan2(dy) - cos_r.acos(), flexion]
+}
+
+/// The soft reach of a two-link chain ("soft IK", as in Mixamo's and Unity's rigs): the distance
+/// at which the chain is drawn for a target `d` from its root, where `max` is the longest span
+/// allowed and `soft` the width of the softening, m. Equal to `d` up to `max − 2·soft`, then a
+/// C¹ quadratic blend that reaches `max − soft` at `max` and holds it beyond, so the middle joint
+/// approaches straight at a vanishing rate instead of at `√(max − d)` (the straight-knee
+/// singularity of a rigid two-link IK, where `dθ/dd` is unbounded).
+pub fn soft_reach(d: f64, max: f64, soft: f64) -> f64 {
+    let start = max - 2.0 * soft;
+    if d <= start {
+        d
+    } else if d >= max {
+        max - soft
+    } else {
+        d - (d - start).powi(2) / (4.0 * soft)
     }
 }
 
@@ -260,5 +309,66 @@ mod tests {
         // The elbow points backward of the shoulder–wrist line.
         let mid = 0.5 * (sh + target);
         assert!((lm[Landmark::LElbow.index()] - mid).x < 0.0);
+    }
+
+    #[test]
+    fn span_and_flexion_are_inverse_and_planar_matches_the_3d_chain() {
+        let (u, l) = (0.43, 0.44);
+        for k in [0.0, 0.1, 0.5, 1.2, 2.5] {
+            let d = span_for_flexion(u, l, k);
+            assert!((flexion_for_span(u, l, d) - k).abs() < 1e-6, "{k}");
+        }
+        // A hip above and behind the ankle: the planar chain's knee lies where the 3-D one's does.
+        let (hip, ankle) = ([0.1, 0.85], [0.25, 0.05]);
+        let [th, k] = planar_two_link(hip, ankle, u, l);
+        let knee = [hip[0] - u * th.sin(), hip[1] - u * th.cos()];
+        let shank = (knee[0] - ankle[0]).hypot(knee[1] - ankle[1]);
+        assert!((shank - l).abs() < 1e-9, "{shank}");
+        let t = two_link(
+            DVec3::new(hip[0], hip[1], 0.0),
+            DVec3::new(ankle[0], ankle[1], 0.0),
+            u,
+            l,
+            DVec3::X,
+        );
+        assert!((t.flexion - k).abs() < 1e-9);
+        assert!((t.middle.x - knee[0]).abs() < 1e-9 && (t.middle.y - knee[1]).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_soft_reach_is_c1_and_bounds_the_knee_rate() {
+        let (max, soft) = (0.87, 0.0015);
+        let h = 1e-7;
+        let slope =
+            |d: f64| (soft_reach(d + h, max, soft) - soft_reach(d - h, max, soft)) / (2.0 * h);
+        // C¹ at both joins, slope within [0, 1], monotone, saturating at max − soft.
+        for d in [max - 2.0 * soft, max] {
+            assert!(
+                (slope(d - 2.0 * h) - slope(d + 2.0 * h)).abs() < 1e-3,
+                "{d}"
+            );
+        }
+        let mut last = 0.0;
+        for i in 0..=400 {
+            let d = max - 0.01 + 0.02 * i as f64 / 400.0;
+            let r = soft_reach(d, max, soft);
+            assert!(r >= last && r <= max - soft + 1e-15);
+            assert!((-1e-9..=1.0 + 1e-9).contains(&slope(d)));
+            last = r;
+        }
+        // The knee's rate per metre of target distance stays bounded through full extension, at
+        // √(2L/(u·l)) / (2√soft) (near straight, L − span = u·l·k²/(2L); inside the blend
+        // L − span = (2·soft − x)²/(4·soft) and its slope is (2·soft − x)/(2·soft), x = d − start,
+        // so the rate is constant there); the rigid chain's grows without bound.
+        let (u, l) = (0.43, 0.44);
+        let rate = |f: &dyn Fn(f64) -> f64, d: f64| (f(d + h) - f(d - h)).abs() / (2.0 * h);
+        let soft_k = |d: f64| flexion_for_span(u, l, soft_reach(d, u + l, soft));
+        let rigid_k = |d: f64| flexion_for_span(u, l, d);
+        let worst = (0..200)
+            .map(|i| rate(&soft_k, u + l - 0.004 + 0.005 * i as f64 / 200.0))
+            .fold(0.0, f64::max);
+        let bound = (2.0 * (u + l) / (u * l)).sqrt() / (2.0 * soft.sqrt());
+        assert!(worst < 1.01 * bound, "{worst} against {bound}");
+        assert!(rate(&rigid_k, u + l - 1e-6) > 1000.0);
     }
 }

@@ -6,6 +6,7 @@ pub mod curves;
 pub mod generalize;
 pub mod ik;
 pub mod motion;
+pub mod numeric;
 pub mod running;
 pub mod schedule;
 pub mod skeleton;

@@ -242,19 +242,7 @@ pub fn check_limits(
     Ok(())
 }
 
-/// Froude number `v²/(g·l)` above which people change from walking to running: 0.5.
-///
-/// Alexander (1989, "Optimization and gaits in the locomotion of vertebrates", Physiol. Rev.
-/// 69) puts the walk–run transition of humans and other animals near 0.5; Kram, Domingo &
-/// Ferris (1997, J. Exp. Biol. 200) measured 0.5 at normal gravity; Thorstensson & Roberthson
-/// (1987) measured ≈ 2.0–2.2 m/s in adults. Eq. (1) has no such bound and completes a walk
-/// there (7 km/h × 1.5 m: Fr 0.53, a step of 1.16 × the leg), so [`crate::generator::walking::generate_walk`]
-/// says so in its report's notes ([`walk_run_note`]); the walk is still generated.
-///
-/// `l` is the stance model's leg `l1` (hip to ankle, [`Body::l1`]), as in
-/// [`super::stance::froude_speed`]; the sources use the hip height, ≈ 8 % longer (l9 + l1), so
-/// gaitfit's Froude number is ≈ 8 % higher and the note comes a little early (at 1.8 m:
-/// 7.4 km/h against 7.7 km/h) — chosen to reuse the leg the stance model scales on.
+/// Froude number `v²/(g·l)` above which people change from walking to running.
 pub const WALK_RUN_FROUDE: f64 = 0.5;
 
 /// Froude number `v²/(g·l1)` of a walk at `speed` m/s with a leg `l1` m long: the square of

@@ -119,37 +119,23 @@ where
         if let (Some(e), Some(gp)) = (event.as_mut(), g_prev) {
             let g = e(t_next, &y_next);
             if gp < 0.0 && g >= 0.0 {
-                // Illinois on τ ∈ (0, h].
-                let (mut a, mut ga, mut b, mut gb) = (0.0, gp, t_next - t, g);
-                let mut side = 0i8;
-                let mut tau = b;
-                for _ in 0..60 {
-                    tau = (a * gb - b * ga) / (gb - ga);
-                    if !(tau > a && tau < b) {
-                        tau = 0.5 * (a + b);
-                    }
-                    let yt = rk4_step(f, t, &y, tau);
-                    let gt = e(t + tau, &yt);
-                    if gt >= 0.0 {
-                        b = tau;
-                        gb = gt;
-                        if side == 1 {
-                            ga *= 0.5;
-                        }
-                        side = 1;
-                    } else {
-                        a = tau;
-                        ga = gt;
-                        if side == -1 {
-                            gb *= 0.5;
-                        }
-                        side = -1;
-                    }
-                    if (b - a).abs() < 1e-12 || gt.abs() < 1e-14 {
-                        break;
-                    }
-                }
-                let tau = if b - a < 1e-12 { b } else { tau };
+                // The crossing time τ ∈ (0, h] on the discrete flow (a zero joins the
+                // after-the-event side).
+                let r = crate::generator::numeric::illinois(
+                    |tau| e(t + tau, &rk4_step(f, t, &y, tau)),
+                    (0.0, gp),
+                    (t_next - t, g),
+                    crate::generator::numeric::Stop {
+                        f_tol: 1e-14,
+                        x_tol: 1e-12,
+                        max_evals: 60,
+                    },
+                );
+                let tau = match r.status {
+                    crate::generator::numeric::Status::Narrow => r.b.0,
+                    _ if r.last.0.is_finite() => r.last.0,
+                    _ => r.b.0,
+                };
                 let yt = rk4_step(f, t, &y, tau);
                 observe(t, &y, t + tau, &yt);
                 return SegmentEnd {

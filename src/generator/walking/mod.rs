@@ -45,10 +45,14 @@
 //! assert_eq!(report.steps.len(), 4);
 //! assert!(motion.len() > 200); // 4 steps of 0.56 s at 100 frames/s
 //! ```
+pub mod ankle_curve;
 pub mod attributes;
 pub mod body;
 pub mod collision;
+pub mod determinants;
+pub mod draw;
 pub mod dynamics;
+pub mod first_step;
 pub mod foot;
 pub mod generate;
 pub mod high_level;
@@ -59,17 +63,60 @@ pub mod shooting;
 pub mod stance;
 pub mod stop;
 pub mod swing;
+pub mod swing_foot;
 pub mod track;
 pub mod virtual_leg;
 
 pub use attributes::{WalkAttributes, ATTRIBUTES};
-pub use generate::{StepReport, WalkOptions, WalkReport};
+pub use generate::{StepReport, WalkReport};
 pub use high_level::{Locomotion, WalkParams, WalkRelations};
 pub use schedule::{walk_params, WalkSchedule};
 
 use crate::generator::motion::Motion;
 use crate::generator::GenerateError;
 use std::path::Path;
+
+/// How a walk is to be generated (besides its steps).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WalkOptions {
+    /// Body height, m.
+    pub height_m: f64,
+    /// Body mass, kg.
+    pub mass_kg: f64,
+    /// Locomotion attributes.
+    pub attributes: WalkAttributes,
+    /// The walking relations (published or fitted).
+    pub relations: WalkRelations,
+    /// Output frame rate, frames/s.
+    pub fps: f64,
+    /// Start from standing, feet side by side: the first step starts from rest (its swing foot
+    /// travels one step length, half a stride), and frame 0 is that first step's start.
+    /// Otherwise the walk starts steady, as a motion-capture trial of steady walking does:
+    /// [`generate::PRE_ROLL`] unrecorded steps are simulated before it, and the recording begins
+    /// mid-motion [`generate::LEAD_IN_FRAMES`] frames before the first heel strike (frame 0 at t = 0,
+    /// the first heel strike at `LEAD_IN_FRAMES / fps`, events and [`StepReport::start_s`] on
+    /// the same clock), in the last pre-roll step's landing swing.
+    pub start_from_rest: bool,
+    /// End standing: a last half step, then the trailing foot is brought alongside and the body
+    /// comes to rest ([`stop`]). Otherwise the walk ends mid-motion: one unrecorded step
+    /// is simulated after the last, and the recording ends [`generate::LEAD_OUT_FRAMES`] frames after the
+    /// trailing foot's toe off that follows the last heel strike.
+    pub stop: bool,
+}
+
+impl Default for WalkOptions {
+    fn default() -> Self {
+        WalkOptions {
+            height_m: 1.8,
+            mass_kg: 75.0,
+            attributes: WalkAttributes::default(),
+            relations: WalkRelations::published(),
+            fps: 100.0,
+            start_from_rest: false,
+            stop: false,
+        }
+    }
+}
 
 /// A stretch of a walk: the locomotion parameters held for a number of steps.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,15 +211,6 @@ pub fn generate_walk(
 /// generator breaks the continuity check from about 1.1 m/s per step). Returns the steps and
 /// the notes: one per ramped change, and one per entry (with steps) whose Froude number exceeds
 /// [`high_level::WALK_RUN_FROUDE`] ([`high_level::walk_run_note`]: it is walked all the same).
-///
-/// - The ramp's n − 1 intermediate steps are taken out of the new stretch, so that the schedule
-///   keeps its step count (and a duration its time). A stretch shorter than its ramp ramps all
-///   along and ends short of its speed; the next change starts from there.
-/// - The intermediate steps walk naturally at their speed (eq. 1) when both stretches are given
-///   by their speed alone; otherwise their step length is interpolated linearly between the two
-///   stretches' (completed) step lengths and the step frequency follows from the speed.
-/// - The first step from standing and the stop's half step are not ramped: they are the start
-///   and the stop of §2.4, with their own from-rest kinematics (measured separately).
 pub fn ramp_schedule(
     schedule: &[ScheduleEntry],
     opts: &WalkOptions,

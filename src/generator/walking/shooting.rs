@@ -149,50 +149,31 @@ pub fn solve_1d_with<F: FnMut(f64) -> f64>(
     if fb.abs() <= tol {
         return done(b, fb, evals, hist);
     }
-    // Illinois on the bracket [a, b].
-    let mut side = 0i8;
-    let mut last_width = (b - a).abs();
-    while evals < max_evals {
-        let mut c = (a * fb - b * fa) / (fb - fa);
-        let width = (b - a).abs();
-        if !(c.is_finite()) || width > 0.7 * last_width && side != 0 && evals % 3 == 0 {
-            c = 0.5 * (a + b);
+    // Illinois on the bracket [a, b] (the generators' one root finder).
+    let budget = max_evals.saturating_sub(evals);
+    let r = crate::generator::numeric::illinois(
+        |x| eval(x, &mut evals, &mut hist),
+        (a, fa),
+        (b, fb),
+        crate::generator::numeric::Stop {
+            f_tol: tol,
+            x_tol: 1e-10,
+            max_evals: budget,
+        },
+    );
+    match r.status {
+        crate::generator::numeric::Status::Root => done(r.last.0, r.last.1, evals, hist),
+        // The bracket has collapsed onto a jump of the residual (no exact root in floating
+        // point): return the best point; the caller reports the remaining error.
+        crate::generator::numeric::Status::Narrow => {
+            let (x, fx) = r.best();
+            done(x, fx, evals, hist)
         }
-        last_width = width;
-        let fc = eval(c, &mut evals, &mut hist);
-        if fc.abs() <= tol {
-            return done(c, fc, evals, hist);
-        }
-        if (b - a).abs() < 1e-10 * (1.0 + c.abs()) {
-            // The bracket has collapsed onto a jump of the residual (no exact root in floating
-            // point): return the better end; the caller reports the remaining error.
-            let (x, r) = if fa.abs() < fb.abs() {
-                (a, fa)
-            } else {
-                (b, fb)
-            };
-            let (x, r) = if fc.abs() < r.abs() { (c, fc) } else { (x, r) };
-            return done(x, r, evals, hist);
-        }
-        if fc.signum() == fb.signum() {
-            b = c;
-            fb = fc;
-            if side == 1 {
-                fa *= 0.5;
-            }
-            side = 1;
-        } else {
-            a = c;
-            fa = fc;
-            if side == -1 {
-                fb *= 0.5;
-            }
-            side = -1;
-        }
+        crate::generator::numeric::Status::Exhausted => Err(format!(
+            "no convergence in {max_evals} simulations (bracket [{}, {}])",
+            r.a.0, r.b.0
+        )),
     }
-    Err(format!(
-        "no convergence in {max_evals} simulations (bracket [{a}, {b}])"
-    ))
 }
 
 /// Solves `f(x) = 0` for two unknowns from `x0` (trial steps `dx` for the finite-difference

@@ -76,15 +76,6 @@ pub const LOCK_BLEND: f64 = 0.02;
 /// `c = Δ (R(s) − max(s, 0))`, `Δ` its rate jump, `R` the integral of a smoothstep rising from 0
 /// to 1 across the window (so `R(±half)` equals the hinge, `c` vanishes outside, and `q + c` is
 /// C² there and C¹ at `t_jump`).
-///
-/// Why: the lock stops the telescopic leg's lengthening (0.15–0.25 m/s) in one instant, and the
-/// virtual leg drawn on it — nearly straight at that moment, knee rate ∝ ẇ/θ4 — turned that into
-/// a knee-rate spike (continuity ratios 6–23 at heel off at 1–2 km/h, 12 at toe off at 5 km/h
-/// × 1.5 m) and a jolt of the trunk and arms. The dynamics keep their ideal lock (the paper's
-/// rigid subphase; the shooting's end state is untouched, as the window ends before `t_step`):
-/// only the recorded motion — what the body and the swing leg's hip are drawn from — is
-/// blended. With `Δ = −ẇ` the drawn leg is never longer than the simulated one (at most
-/// `3·half·|ẇ|/16` shorter, ≈ 0.8 mm), so the virtual leg always reaches its ankle.
 pub fn blend_rate_jump<const N: usize>(track: &mut Track<N>, t_jump: f64, half: f64) {
     if half <= 0.0 {
         return;
@@ -172,27 +163,16 @@ pub struct StanceSpec {
     pub rest_ramp_in: f64,
 }
 
-/// Fraction of the stance over which the leg spring's shortened rest length ramps in from
-/// heel strike ([`StanceSpec::rest_length`]) from Froude speed 0.20 up (≈ 2 km/h at 1.8 m); the
-/// slowest walks ramp it in over [`REST_RAMP_IN_SLOW`] (blended between, see
-/// `generate::SLOW_REST_FROUDE`). Measured against 0.1 (2 km/h, 8 steps): the heel ≤ 0.29 mm against
-/// 0.00 mm, but the knee a few frames after foot flat 2.9/2.8/2.7 against 3.5/2.9/2.8 at
-/// 1.5/1.8/2.0 m, and from standing at 1.5 m 2.9 against 3.6.
+/// Fraction of the stance over which the leg spring's shortened rest length ramps in from heel
+/// strike ([`StanceSpec::rest_length`]) from Froude speed 0.20 up (≈ 2 km/h at 1.8 m).
 pub const REST_RAMP_IN: f64 = 0.2;
 
-/// [`REST_RAMP_IN`] of the slowest walks (`generate::SLOW_REST_REACH`, blended over the same
-/// Froude speeds).
-///
-/// Why: their hip must be down by foot flat, 8–12 % into the stance; over 20 % the heel still
-/// rose 0.9–1.9 mm at 1.0–1.5 km/h. Why not at every speed: over 10 % at 2.5–3 km/h (Froude
-/// 0.20–0.24) the worst continuity ratio rose by up to 1.5 (2.6 km/h × 2.0 m 2.92 → 4.40).
+/// [`REST_RAMP_IN`] of the slowest walks (`generate::SLOW_REST_REACH`, blended over the same Froude
+/// speeds).
 pub const REST_RAMP_IN_SLOW: f64 = 0.1;
 
-/// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by
-/// the end of the stance ([`StanceSpec::rest_length`]): the next heel strike meets the hip
-/// where the paper's spring puts it, so a change of speed into a walk without the shortening
-/// lands as before (with the rest length kept short to the end, a 2 → 3.5 km/h step of a
-/// 1.5 m body from standing jumped at the landing knee: 4.12 → 8.2).
+/// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by the end
+/// of the stance ([`StanceSpec::rest_length`]).
 pub const REST_RAMP_OUT: f64 = 0.5;
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
@@ -233,32 +213,6 @@ pub const FIRST_PUSH_OFF_FROUDE_RAMP: f64 = 0.05;
 /// rising (smoothstep in Froude speed) to [`PUSH_OFF_MAX`] over
 /// [`FIRST_PUSH_OFF_FROUDE_RAMP`] — ≈ 3.0 → 3.5 km/h for a 1.8 m body, 2.75 → 3.2 km/h for
 /// 1.5 m. A change to the paper (klawstart4), which gives no profile for `pa`.
-///
-/// Why: the first stance starts at rest on a vertical leg, so its whole stance is the extension,
-/// and the quadratic profile spread the leg's lengthening (from the standing length to eq. 3's
-/// at heel strike) over the step: the leg reached heel strike lengthening at only 0.11 m/s
-/// while it swept forward, and the hip fell onto the next heel at −0.43 m/s (4 km/h × 1.5 m;
-/// −0.21 m/s at the walk's later heel strikes, which push off). The landing leg's flat foot
-/// was then within reach 31 ms after heel strike and its knee rose as √ (0.38 rad at its
-/// peak), so the planned heel rocker (`VirtualLeg::plan_heel_rocker`) could only start the
-/// knee, straight and at rest in swing3, at 3 × its mean rate: 0.126 rad in the first frame
-/// (continuity 5.17 at 4 km/h × 1.5 m, 5.37 at 1.55 m, frame 57–58, r_knee). A late profile puts
-/// the extension where a person starting to walk pushes off with the first stance leg, just
-/// before the other heel lands: at `n` = 6 the leg lengthens at 0.26 m/s at heel strike and the
-/// hip falls at −0.30 m/s, and the rocker's knee starts at 2.5 × its mean rate (4 km/h × 1.5 m
-/// 5.17 → 4.40, 1.55 m 5.37 → 4.59). The walk's own exponent (3.1 there) is not enough (3.0:
-/// 5.24/5.44); a constant exponent of 3.5–5.5 for every speed put 3.5 km/h × 1.5 m (8 steps)
-/// at 5.09–5.26 (its heel rocker switched landings), only 6 kept it down (3.79 → 4.34), and 6
-/// at 3 km/h × 1.8 m made its start worse (3.30 → 3.61): below [`PUSH_OFF_FROUDE_0`] the first
-/// stance keeps the paper's profile, as the walk does. Measured (from standing with a stop,
-/// continuity k = 5): the 243-walk regression sweep 12 → 11 over 5, one walk worse (4 km/h ×
-/// 2.0 m 3.55 → 3.81, frame 66 r_knee), 7 km/h × 1.5 m 5.62 → 5.56 (the push-off here once
-/// measured 12.0 → 14.8 there, on an earlier state of the walk); 2.8–4.2 km/h every
-/// 0.05 × 1.5–1.7 m every 5 cm (6 steps, 145 walks) 4 → 1 over 5 (the one left, 3.3 km/h ×
-/// 1.55 m, is a later stance's knee, unchanged), mean change −0.12, the largest rise 3.5 km/h ×
-/// 1.55 m 3.21 → 4.24; 1–7 km/h every 0.25 × 1.5–2.0 m every 10 cm (8 steps, 150 walks) 4 → 3
-/// over 5, the largest rise 3.5 km/h × 1.6 m 3.28 → 4.21. Ramps of 0.03 and 0.07 measured the
-/// same (sweep identical, 1 of the 145 over 5).
 pub fn first_push_off_exponent(speed: f64, l1: f64) -> f64 {
     let froude = froude_speed(speed, l1);
     let u = ((froude - PUSH_OFF_FROUDE_0) / FIRST_PUSH_OFF_FROUDE_RAMP).clamp(0.0, 1.0);
@@ -276,19 +230,6 @@ pub const LOCK_SHORT_MAX: f64 = 0.01;
 /// with push-off exponent `push_off` ([`push_off_exponent`]): 0 up to the push-off's Froude
 /// speed (the paper's lock), then [`LOCK_SHORT_PER_PUSH`] per unit of exponent, at most
 /// [`LOCK_SHORT_MAX`] — 0.5 / 1.0 / 1.0 % at 4 / 5 / 7 km/h for a 1.8 m body.
-///
-/// Why (issue 6): the rigid leg at `l1` vaults the hip 5–8 cm above its heel-strike height
-/// and brings it down into the next contact at −0.34 m/s (5 km/h) to −0.48 m/s (7 km/h), 1.8 m;
-/// the landing heel's roll then starts at the hip's approach over the heel lever (≈ 20 rad/s),
-/// the landing ankle's continuity spike at 4–7 km/h. A human's stance knee stays flexed
-/// 10–20° through midstance at brisk speeds. Measured choices (8 steps, worst continuity ratio
-/// 1.5/1.8/2.0 m): 4 km/h 6.58/4.22/3.31 → 5.14/3.51/3.37, 5 km/h 9.29/4.74/3.82 →
-/// 6.16/4.17/3.34, 6 km/h 10.7/6.46/4.55 → 10.05/6.34/4.24, 7 km/h 11.0/10.2/6.15 →
-/// 11.4/6.44/5.32 (7 km/h × 1.5 m worse: its heel strikes); a cap of 0.8 % or 1.2 % moved 7 km/h × 1.5 m the same way (11.4–11.5), and
-/// 3 % landed no planned heel rocker at 5–7 km/h (the hip never came within the shorter leg of
-/// the flat ankle before the lock). Spreading the re-lengthening to `l1` over the first half of
-/// the extension instead (the knee straightening early) gave the benefit back (5 km/h × 1.5 m
-/// 9.2, 7 km/h × 1.8 m 9.9): what helps is the late extension.
 pub fn lock_shortening(push_off: f64) -> f64 {
     (LOCK_SHORT_PER_PUSH * (push_off - 2.0)).clamp(0.0, LOCK_SHORT_MAX)
 }
@@ -351,26 +292,6 @@ impl StanceSpec {
     /// shorten it: it is the drawn leg's lateral geometry, not a knee flexion to keep. The part
     /// of [`StanceSpec::flat_reach`] the lock does not take (`flat_reach − lock_reach`)
     /// lengthens it, up to `leg_span`: the midstance knee is drawn with the 3-D leg's flexion.
-    ///
-    /// Why the 3-D leg's flexion (a change to the paper's planar virtual leg, issue 6): the
-    /// rigid leg is sagittal, the drawn hip `dz` beside the foot, so a knee drawn for the
-    /// sagittal length `l1 (1 − δ)` left the flat ankle ≈ `dz²/2l` + the soft knee's `2σ` out of
-    /// reach and the foot rolled onto its ball: the heel hovered 4.2 / 5.1 mm from foot flat to
-    /// heel off at 7 km/h × 1.5 / 1.8 m, where the lock is not shortened by the reach (its
-    /// lower hip made the arms jolt harder at heel strike, see
-    /// `generate::PROJECTED_LOCK_FROUDE_MAX`). Drawn with the 3-D span the heel stays down
-    /// (0.00 mm) and the dynamics, hence every continuity ratio, are unchanged.
-    ///
-    /// Why the turned lock keeps its knee: with `lock_reach` more legs lock where they turn
-    /// just above the lock length; drawn with the straight leg's span their knee straightened
-    /// through the extension and stopped at the other foot's heel strike (5 km/h × 1.8 m,
-    /// continuity 4.17 → 6.52; 3.63 with this rule).
-    ///
-    /// Why the knee does not straighten during the extension: the late extension is fast
-    /// (≈ 0.5–1 m/s at heel strike), and a drawn knee straightening at that rate up to the
-    /// straight leg's soft limit right at the other foot's heel strike snapped to rest there
-    /// (the trailing knee, continuity 5.4–8.8 at 5 km/h × 1.8/2.0 m, measured before
-    /// `generate`'s knee hold through the double support).
     pub fn drawn_span(&self, run: &StanceRun, leg_span: f64) -> f64 {
         // Only the midstance knee's shortening: `lock_reach` is the drawn leg's own geometry.
         // A leg that locked where it turned above the lock length keeps the knee it turned
@@ -395,12 +316,6 @@ impl StanceSpec {
     /// The leg spring's rest length at stance time `t`, m: `l1` shortened by
     /// [`StanceSpec::rest_reach`] (smoothstep in over the first [`REST_RAMP_IN`] of the
     /// stance, out again from [`REST_RAMP_OUT`] to its end).
-    ///
-    /// Not in the paper (its spring rests at `l1`). Why: in slow walks the leg lands longer than
-    /// `l1` (1 km/h × 1.8 m: 12 mm) and turns about 0.1 s into the stance within a millimetre of
-    /// `l1`, above any shortened lock, so the rigid leg locks where it turns and the drawn 3-D
-    /// leg cannot reach its flat foot: the stance heel hovered 4–5.5 mm through midstance at
-    /// 2 km/h. Only a shorter rest length lowers the hip there (klawflat3, session 7).
     pub fn rest_length(&self, t: f64) -> f64 {
         let d = self.duration.max(1e-9);
         let on = smoothstep((t / (self.rest_ramp_in.max(1e-3) * d)).clamp(0.0, 1.0));

@@ -18,13 +18,11 @@
 //!   swing time of the last step (stride width kept), with zero velocity;
 //! - the trunk's lean returns to its reference angle.
 use super::foot::FootShape;
-use super::generate::interp_rho;
+use super::track::interp_rho;
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
 use crate::events::Side;
 
-/// Knee slack of the standing legs: hip-to-ankle distance `l1 − slack` (a knee flexion of ≈ 5°
-/// for a 0.84 m leg), m. A fully straight leg would put the inverse kinematics on its reach
-/// limit.
+/// Knee slack of the standing legs.
 pub const STAND_KNEE_SLACK: f64 = 0.001;
 
 /// How far the hip comes to rest ahead of the ankles, m (in quiet standing the line of gravity
@@ -347,18 +345,6 @@ impl Closing {
     /// `EARLY`, 0.05 s) after the straight leg reaches its pitched ankle, rad/s: the last step's
     /// swing foot lands into it (see [`super::swing::SwingFoot::theta5_rate_hs`]), as every
     /// step's lands into the next step's heel rocker.
-    ///
-    /// Why past the reach: until then (2–12 ms; the 3-D leg may fall a millimetre short of the
-    /// sagittal heel-strike geometry) the foot holds its landing pitch while the shank turns over
-    /// it, θ5 *rising*, and only then rolls. Over a fixed `window` from the contact the hold
-    /// could fill most of it and cancel the roll (4 km/h × 2.0 m: hold 8 ms, +0.47 rad/s over
-    /// 10 ms against a roll of −1.32), so the swing ankle arrived at rest while the stance ankle
-    /// then turned 0.012 rad in the first frame against a median of 0.0023 (continuity 5.23;
-    /// 5.34 on 1.5 → 4 km/h × 2.0 m; 3.23 and 3.61 now). Why from the contact, not from the
-    /// reach: the rolling rocker's own early rate (−3 to −4 rad/s at 6–7 km/h, whose roll then
-    /// decays within 2–3 frames) made the swing3 cubic end 4 rad/s into a first stance frame
-    /// that also holds (4 → 7 km/h × 1.8 m 4.62 → 6.08); the mean over the hold and the first
-    /// `window` of roll is what the first drawn step after the contact covers (4.88 there).
     pub fn contact_ankle_rate(&self, window: f64) -> f64 {
         let s = &self.stance_theta5;
         let end = self.stance_reach + window.min(EARLY);

@@ -25,16 +25,16 @@
 //!
 //! The foot is kinematic: the ankle angle θ5 and the toe bend θ6 are interpolated (C¹) between
 //! their toe-off and heel-strike values.
+pub use super::ankle_curve::{knee_on_circle, AnkleCurve, KNEE_BRANCH_STEP};
 use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
 use super::foot::{FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_1d, solve_1d_with, solve_2d_with, Solved};
+pub use super::swing_foot::{SwingFoot, CLEARANCE_RAMP_MIN, CLEARANCE_SOFT};
 use super::track::{Node, Track};
-use crate::generator::curves::smoothstep;
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::f64::consts::FRAC_PI_2;
 use std::hash::{BuildHasherDefault, Hasher};
 
 /// Everything that defines one swing phase.
@@ -73,206 +73,12 @@ pub struct SwingSpec<'a> {
     /// [`RECOVERY_END`], at most until the path's peak) and swing3 lands the thigh at
     /// [`SwingSpec::theta3_rate_hs`]; otherwise the paper's swing2 and swing3 (one torque each,
     /// the knee locks at whatever rate it reaches).
-    ///
-    /// `generate` brakes every swing; the first from standing since klawstart2 (with its
-    /// swing1 end and ankle lift chosen for a hip starting from rest, see `generate`'s
-    /// `first_swing_shape`).
     pub knee_brake: bool,
     /// Thigh rate θ̇3 at heel strike, rad/s, which swing3 meets (with a second torque, a ramp
     /// `D·(t − t2)/(t_swing − t2)`) when `knee_brake` is set: `generate` passes the rate for
     /// which the heel-strike collision leaves the hip's forward velocity unchanged.
-    ///
-    /// Why: swing3's single exponential torque landed whatever rate it reached. With the
-    /// paper's lock that was a 1.8–2.4 rad/s retraction; with the braked knee the thigh arrives
-    /// at t2 near its heel-strike angle and at rest, and the free rate came out between −0.6
-    /// (still flexing, at 5–7 km/h: the collision then threw the hip forward by 0.12 m/s, and
-    /// the trailing knee and ankle spiked at heel strike) and +0.6 rad/s. The collision's
-    /// momentum balance is linear in θ̇3, so the rate that keeps the hip's forward velocity
-    /// continuous is known before the swing is simulated.
     pub theta3_rate_hs: f64,
 }
-
-/// The kinematic swing foot (§4.3): the ankle angle θ5 and the toe bend θ6 are interpolated
-/// (C¹ blends) between their toe-off values, a dorsiflexed value at the end of swing1 and the
-/// heel-strike values; θ6 returns to 0 by the end of swing1.
-///
-/// The paper interpolates θ5 and θ6 between toe-off and heel strike only. In slow walks (long
-/// swings, short steps) that foot pitches toe-down while the knee extends in swing2 and the toe
-/// goes through the ground, and no temporary hip torque can lift it in time (the dip comes a few
-/// centiseconds into swing2, faster than the thigh responds). The locomotion attribute "toe
-/// clearance during swing" is therefore also honoured kinematically, as a person does: the ankle
-/// dorsiflexes beyond the interpolated value just enough for the toe and ball to stay
-/// `clearance` above the ground (the clearance ramps in from 0 at toe-off over the first 30 % of
-/// swing1, at least 15 % of the swing, [`SwingFoot::clearance_ramp`], while the toe is leaving
-/// the ground), up to the dorsiflexion limit `theta5_max`. The
-/// dynamic recovery of swing2 still handles what this cannot (the heel).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SwingFoot {
-    /// The foot.
-    pub foot: FootShape,
-    /// Toe-off, end of swing1, end of swing2, heel strike, s.
-    pub times: [f64; 4],
-    /// θ5 at toe-off, at the end of swing1 and at heel strike, rad.
-    pub theta5: [f64; 3],
-    /// θ6 at toe-off, rad.
-    pub theta6_toe_off: f64,
-    /// Toe clearance, m.
-    pub clearance: f64,
-    /// Dorsiflexion limit of θ5, rad.
-    pub theta5_max: f64,
-    /// Rate of θ5 at heel strike, rad/s: the landing foot's ankle rate just after heel strike
-    /// (bounded by `generate`'s `MAX_CONTACT_ANKLE_RATE`), set once the next stance's heel rocker
-    /// is planned; 0 while the swing is simulated (swing3's θ5 does not enter the dynamics).
-    pub theta5_rate_hs: f64,
-    /// Weight in [0, 1] of the [`SwingFoot::contact_ramp`] against the swing3 cubic (see
-    /// [`SwingFoot::theta56`]), set with [`SwingFoot::theta5_rate_hs`] (`generate`'s
-    /// `contact_ramp_weight`); 0 while the swing is simulated.
-    pub contact_ramp_weight: f64,
-}
-
-impl SwingFoot {
-    /// Interpolated θ5 and θ6 at `t` (before the clearance rule).
-    ///
-    /// In swing3 (`t2 → t3`) θ5 gets the cubic `ṙ·T3·(u − 1)·u²` (`u` the fraction of swing3,
-    /// `ṙ` = [`SwingFoot::theta5_rate_hs`]): zero with zero rate at `t2` and zero at heel strike,
-    /// where its rate is `ṙ`. The paper's interpolation brings the ankle to rest at heel strike,
-    /// while the stance foot starts rolling about the heel at once — a one-frame spike of the
-    /// ankle's rotation; this makes θ5 C¹ across the contact.
-    ///
-    /// That cubic reaches `ṙ` within the last third of swing3 only (1–2 frames at 5–7 km/h) and
-    /// pays for it with a dorsiflexion bump before; the landing ankle's steps then jumped from
-    /// ≈ 0.02 to the stance roll's 0.11–0.17 rad/frame (continuity 5.3–11.4 at the heel strikes
-    /// of 5–7 km/h × 1.5 m). It is blended (weight [`SwingFoot::contact_ramp_weight`]: 0 where
-    /// the stance roll's rate is within the cap, 1 where it is twice the cap) with the
-    /// [`SwingFoot::contact_ramp`], which spends the paper's own plantarflexion from the
-    /// end of swing1 to heel strike (`θ5` mid-swing → heel strike) as a rate rising steadily
-    /// into the contact over the last 4–6 frames, with no bump.
-    pub fn theta56(&self, t: f64) -> (f64, f64) {
-        let [t0, t1, t2, t3] = self.times;
-        let [to, mid, hs] = self.theta5;
-        let s1 = smoothstep((t - t0) / (t1 - t0));
-        let mut th5 = if t <= t1 {
-            to + (mid - to) * s1
-        } else {
-            mid + (hs - mid) * smoothstep((t - t1) / (t3 - t1))
-        };
-        if t > t2 && t3 > t2 {
-            // Swing3 only: the cubic correction that leaves θ5 and its rate unchanged at t2 and
-            // its value at heel strike, and ends with the rate the stance foot takes on.
-            let u = ((t - t2) / (t3 - t2)).min(1.0);
-            th5 += self.theta5_rate_hs * (t3 - t2) * (u - 1.0) * u * u;
-        }
-        let w = self.contact_ramp_weight.clamp(0.0, 1.0);
-        if t > t1 && t3 > t1 && w > 0.0 {
-            th5 = (1.0 - w) * th5 + w * self.contact_ramp(t);
-        }
-        (th5, self.theta6_toe_off * (1.0 - s1))
-    }
-
-    /// θ5 from the end of swing1 to heel strike (`t1 → t3`, `u` the fraction of that time
-    /// `T13`): from its mid-swing value `θm` at rest to its heel-strike value `θh` at the contact
-    /// rate `ṙ` ([`SwingFoot::theta5_rate_hs`]), through `θm + (θh − θm)·u^s`,
-    /// `s = ṙ·T13 / (θh − θm)`, when `s ≥ 2`: monotone (never beyond either end, no extra
-    /// dorsiflexion), C¹ at both ends, its rate rising steadily into the contact. For `s < 2`
-    /// (a slow landing, or a rate against the interpolation's direction) the cubic Hermite of
-    /// the same ends (equal to `u²` at `s = 2`).
-    ///
-    /// Measured (5 km/h × 1.5 m, `ṙ` = 6 rad/s, `s` ≈ 7): the last four pre-contact ankle steps
-    /// 0.015, 0.022, 0.030, 0.041 rad/frame rising into the stance's 0.11, against 0.011, 0.009,
-    /// 0.002, 0.022 with the swing3 cubic alone; the foot's largest pitch in late swing
-    /// 36.4° → 40.2° (7 km/h × 1.5 m).
-    pub fn contact_ramp(&self, t: f64) -> f64 {
-        let [_, t1, _, t3] = self.times;
-        let [_, mid, hs] = self.theta5;
-        let big_t = t3 - t1;
-        if big_t <= 0.0 {
-            return hs;
-        }
-        let u = ((t - t1) / big_t).clamp(0.0, 1.0);
-        let d = hs - mid;
-        let r_t = self.theta5_rate_hs * big_t;
-        if d * r_t > 0.0 && r_t / d >= 2.0 {
-            mid + d * u.powf(r_t / d)
-        } else {
-            mid + d * (3.0 - 2.0 * u) * u * u + r_t * (u - 1.0) * u * u
-        }
-    }
-
-    /// Foot pitch φ (toes up positive) and toe bend θ6 at `t`, for the ankle at `ankle` (ground
-    /// frame) and the shank at `shank = θ3 + θ4` from the vertical.
-    ///
-    /// The clearance rule takes the larger of the interpolated pitch and the pitch that holds
-    /// the lower of toe and ball at the clearance, through a smooth maximum of width
-    /// [`CLEARANCE_SOFT`] (ramped in with the clearance after toe-off, faded out over swing3,
-    /// so toe-off and heel strike keep their pitches):
-    /// a hard maximum engages and releases with a kink in the ankle's rate, which the short
-    /// spells of clearance in fast walks turned into one-to-three-frame spikes (continuity
-    /// ratios 5–7.5 on the ankle a third of the way into the swing at 7 km/h). The smooth
-    /// maximum is never below either, so the foot clears at least as before.
-    pub fn pose(&self, t: f64, ankle: [f64; 2], shank: f64) -> (f64, f64) {
-        let [t0, _, t2, t3] = self.times;
-        let (th5, th6) = self.theta56(t);
-        let phi_i = th5 - FRAC_PI_2 - shank;
-        let need = self.clearance * smoothstep((t - t0) / self.clearance_ramp());
-        let phi_max = self.theta5_max - FRAC_PI_2 - shank;
-        if phi_i >= phi_max {
-            return (phi_i, th6);
-        }
-        // Newton on the lower of toe and ball: d(point_y)/dφ = (point − ankle)_x.
-        let mut phi_c = phi_i;
-        for _ in 0..8 {
-            let p = self.foot.points(ankle, phi_c, th6);
-            let (low, lx) = if p.toe[1] < p.ball[1] {
-                (p.toe[1], p.toe[0])
-            } else {
-                (p.ball[1], p.ball[0])
-            };
-            let slope = lx - ankle[0];
-            if slope <= 1e-6 {
-                break;
-            }
-            let step = ((need - low) / slope).clamp(-0.5, 0.5);
-            phi_c += step;
-            if step.abs() < 1e-10 {
-                break;
-            }
-        }
-        // The width ramps in with the clearance (at toe-off the toe is on the ground, where the
-        // two pitches agree: a full width would pitch the foot up at once).
-        let ramp = smoothstep((t - t0) / self.clearance_ramp());
-        let e = CLEARANCE_SOFT * ramp * (1.0 - smoothstep((t - t2) / (t3 - t2)));
-        let phi = 0.5 * (phi_i + phi_c + ((phi_i - phi_c).powi(2) + e * e).sqrt());
-        (phi.min(phi_max), th6)
-    }
-
-    /// How long after toe off the toe clearance takes to ramp in, s: 30 % of swing1, but at
-    /// least [`CLEARANCE_RAMP_MIN`] of the swing.
-    ///
-    /// Why the floor: the first swing from standing may end swing1 at 25–30 % of the swing
-    /// (`generate`'s `first_swing_shape`), and 30 % of that lifted the toe to its clearance in
-    /// 4 frames, then held it (2.5 km/h × 1.55 m from standing: 6.24 at the toe, 2 km/h × 1.8 m
-    /// 3.74). Every swing whose swing1 ends at half the swing or later (the paper's default, the
-    /// stop's) keeps its ramp.
-    pub fn clearance_ramp(&self) -> f64 {
-        let [t0, t1, _, t3] = self.times;
-        (0.3 * (t1 - t0)).max(CLEARANCE_RAMP_MIN * (t3 - t0))
-    }
-
-    /// Foot sole points at `t` (see [`SwingFoot::pose`]).
-    pub fn points(&self, t: f64, ankle: [f64; 2], shank: f64) -> FootPoints {
-        let (phi, th6) = self.pose(t, ankle, shank);
-        self.foot.points(ankle, phi, th6)
-    }
-}
-
-/// Least time over which the swing toe's clearance ramps in after toe off, as a fraction of the
-/// swing (see [`SwingFoot::clearance_ramp`]): 30 % of a swing1 that ends at half the swing.
-pub const CLEARANCE_RAMP_MIN: f64 = 0.15;
-
-/// Width of the swing foot's smooth maximum between its interpolated pitch and the pitch the
-/// toe clearance needs, rad (see [`SwingFoot::pose`]): about 1.4° of extra dorsiflexion where
-/// the two meet, spread over ≈ 5 frames at the rates of a 7 km/h swing.
-pub const CLEARANCE_SOFT: f64 = 0.05;
 
 /// State at toe-off: `[θ3, θ4]` and rates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -281,101 +87,6 @@ pub struct SwingStart {
     pub q: [f64; 2],
     /// `[θ̇3, θ̇4]`, rad/s.
     pub qd: [f64; 2],
-}
-
-/// The ankle curve `P` of swing1: `y(x) = Σ c_i x^i`, x measured from the ankle at toe-off.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AnkleCurve {
-    /// Coefficients `c0..c4`.
-    pub c: [f64; 5],
-    /// Ankle x at toe-off (origin of x), m.
-    pub x0: f64,
-    /// `D`: the ankle's forward travel at t1, m.
-    pub d: f64,
-    /// `a0`, `a_max`, `a_min`, m.
-    pub heights: [f64; 3],
-}
-
-impl AnkleCurve {
-    /// Fits the five conditions `y(0) = a0, y(C) = a_max, y'(C) = 0, y(D) = a_min, y'(D) = 0`
-    /// with `C = 0.3·D` (§4.3).
-    pub fn fit(x0: f64, d: f64, a0: f64, a_max: f64, a_min: f64) -> Option<AnkleCurve> {
-        let c = PEAK_AT * d;
-        let m = nalgebra::Matrix4::new(
-            c,
-            c * c,
-            c.powi(3),
-            c.powi(4),
-            1.0,
-            2.0 * c,
-            3.0 * c * c,
-            4.0 * c.powi(3),
-            d,
-            d * d,
-            d.powi(3),
-            d.powi(4),
-            1.0,
-            2.0 * d,
-            3.0 * d * d,
-            4.0 * d.powi(3),
-        );
-        let rhs = nalgebra::Vector4::new(a_max - a0, 0.0, a_min - a0, 0.0);
-        let sol = m.lu().solve(&rhs)?;
-        Some(AnkleCurve {
-            c: [a0, sol[0], sol[1], sol[2], sol[3]],
-            x0,
-            d,
-            heights: [a0, a_max, a_min],
-        })
-    }
-
-    /// The quartic that leaves `a0` level and peaks at `C = γ·D`: `y(0) = a0, y'(0) = 0,
-    /// y'(C) = 0, y(D) = a_min, y'(D) = 0` (`γ` = `peak` in `[0, 0.3]`; its peak height follows).
-    /// At `γ` = 0.3 it is §4.3's curve with the peak for which `y'(0) = 0`; at `γ = 0` (the
-    /// condition at C read as `y''(0) = 0`) it has no peak and falls over all of `D`
-    /// (`a_min + A0·(1 − 4u³ + 3u⁴)`). Used where the reach condition ([`REACH_SHARE`]) leaves
-    /// no room for a peak at `0.3·D` (see `reach_curve`).
-    pub fn fit_level(x0: f64, d: f64, peak: f64, a0: f64, a_min: f64) -> Option<AnkleCurve> {
-        let c = peak * d;
-        // c1 = 0; y'(C)/C = 2·c2 + 3·c3·C + 4·c4·C² = 0 (well-defined at C = 0).
-        let m = nalgebra::Matrix3::new(
-            2.0,
-            3.0 * c,
-            4.0 * c * c,
-            d * d,
-            d.powi(3),
-            d.powi(4),
-            2.0 * d,
-            3.0 * d * d,
-            4.0 * d.powi(3),
-        );
-        let rhs = nalgebra::Vector3::new(0.0, a_min - a0, 0.0);
-        let sol = m.lu().solve(&rhs)?;
-        let mut curve = AnkleCurve {
-            c: [a0, 0.0, sol[0], sol[1], sol[2]],
-            x0,
-            d,
-            heights: [a0, a0, a_min],
-        };
-        curve.heights[1] = curve.eval(x0 + c).0;
-        Some(curve)
-    }
-
-    /// `d²y/dx²` at ankle position `x` (absolute).
-    pub fn curvature(&self, x: f64) -> f64 {
-        let u = x - self.x0;
-        let c = &self.c;
-        2.0 * c[2] + u * (6.0 * c[3] + u * 12.0 * c[4])
-    }
-
-    /// `(y, dy/dx)` at ankle position `x` (absolute).
-    pub fn eval(&self, x: f64) -> (f64, f64) {
-        let u = x - self.x0;
-        let c = &self.c;
-        let y = c[0] + u * (c[1] + u * (c[2] + u * (c[3] + u * c[4])));
-        let dy = c[1] + u * (2.0 * c[2] + u * (3.0 * c[3] + u * 4.0 * c[4]));
-        (y, dy)
-    }
 }
 
 /// Solver state carried from one step's swing to the next (like the force profiles
@@ -427,85 +138,29 @@ const TOL: f64 = 1e-8;
 /// Increment of the swing2 recovery's position actuator, rad.
 const RECOVERY_STEP: f64 = 0.02;
 
-/// Largest number of recovery increments (0.8 rad of set-point shift). The soft swing2 hip
-/// spring lifts the foot only ≈ 1 mm per increment in fast walks of short bodies (7 km/h at
-/// 1.5 m needs ≈ 25); 20 left the heel up to 4 mm in the ground there.
+/// Largest number of recovery increments (0.8 rad of set-point shift).
 const RECOVERY_MAX: usize = 40;
 
-/// Largest set-point shift of swing2's ground-stubbing recovery, rad (`RECOVERY_MAX` grid
-/// steps of 0.02 rad). A walk whose recovery reaches it has run out of actuator: the foot may
-/// then scuff. No steady walk of 1–7 km/h × 1.5–2.0 m reaches it (property-tested; at most
-/// 0.42 rad), nor does a walk with a stop (property-tested; the stop's half step needs the
-/// most, at most 0.64 rad at 3.5 km/h × 1.5 m since the swings before a stop are braked; it
-/// needed all of it at 3–4 km/h × 1.5–1.55 m before, one grid step from scuffing).
+/// Largest set-point shift of swing2's ground-stubbing recovery, rad (`RECOVERY_MAX` grid steps of
+/// 0.02 rad).
 pub const RECOVERY_MAX_RAD: f64 = RECOVERY_MAX as f64 * RECOVERY_STEP;
 
-/// Power `n` of the swing2 knee brake's shape `E·uⁿ` (`u` the fraction of swing2): the brake
-/// acts in terminal swing, where the hamstrings decelerate a human knee's extension.
-///
-/// Why a brake at all: with the paper's single exponential knee torque the knee slammed into
-/// the swing3 lock at 5–7 rad/s (measured at every speed; 7.0 rad/s at 3 km/h × 1.8 m once the
-/// toe off is brisk, [`super::virtual_leg::TOE_OFF_KNEE_RATE`]) and the lock's inelastic impulse
-/// (θ̇3⁺ = θ̇3 + (M01/M00)·θ̇4) kicked the thigh by ≈ 2.5 rad/s in one instant; the arms, which
-/// follow the thigh, showed it as elbow/shoulder spikes (continuity ratios 6.3–6.5 at 3 km/h).
-/// With the brake, swing2 solves for two torque magnitudes (`B`, `E`) so that the knee is
-/// straight *and at rest* at t2: the lock conserves everything and the knee decelerates into
-/// extension, as a human knee does before heel strike. 6: measured against 2, 4 and 8 (8 steps,
-/// 1–4 km/h × 1.5/1.8/2.0 m and the default-event double support): the broader shapes brake
-/// while the foot is still low and need a larger stubbing recovery.
+/// Power `n` of the swing2 knee brake's shape `E·uⁿ` (`u` the fraction of swing2).
 pub const KNEE_BRAKE_POWER: i32 = 6;
 
 /// Fraction of swing2 over which the ground-stubbing recovery's set-point shift
 /// `pa·sin(π·u/RECOVERY_END)` acts (the paper's shape spans all of swing2).
-///
-/// Why: the hip spring–damper lags its set point, so a shift that returned to the heel-strike
-/// angle only at t2 left the thigh 0.05–0.09 rad ahead of it in slow walks (1.5–3 km/h, which
-/// need the recovery); swing3 then pulled the thigh back and the heel, having swung past its
-/// landing spot, came back 3–17 cm at up to 4.5 m/s over the ground before contact (gaitfit's
-/// foot-speed events saw the heel strike 30–60 ms early). Ending the shift at 85 % of swing2
-/// gives the thigh the rest of swing2 to settle (measured: 0.8 over-corrected at 3 km/h × 2.0 m,
-/// 0.9 left 1.5 km/h × 1.6 m's double support 42 ms long).
 pub const RECOVERY_END: f64 = 0.85;
 
-/// Time before heel strike at which the swing thigh reaches its peak flexion and starts to
-/// retract, as a fraction of the gait cycle (two steps, `2·t_step`): the knee-braked swing2
-/// follows the terminal-swing path (`ThighPath`, at most [`RETRACTION_SHARE_MAX`] of the time
-/// from the end of swing1 to heel strike).
-///
-/// Why: a human thigh reaches its peak flexion at ≈ 85 % of the cycle and retracts through
-/// terminal swing into the contact (Winter's hip angle); the swing2 spring held the thigh
-/// forward of its landing angle until the knee lock (85 % of the swing), so the thigh flexed
-/// until ≈ 6 % of the cycle before contact (1–6 km/h, 5 % at 6–7 km/h × 2.0 m, the drawn
-/// thigh's hip–knee line) and the whole retraction to the collision-neutral landing rate
-/// ([`SwingSpec::theta3_rate_hs`], 1–4 rad/s) fell into swing3's 60–110 ms. Measured (8
-/// steps, 1–7 km/h × 1.5/1.8/2.0 m, the drawn thigh's peak before contact): 0.13 puts it at
-/// 10.6–13.3 % of the cycle from 3 km/h up, 9.5–12.4 % at 2 km/h and 8.9–9.6 % at 1 km/h (whose
-/// swing is only 30 % of the cycle: the cap). 0.14 with [`RETRACTION_POWER`] 3 gave 11–14 % but
-/// put `klaw_events`' default double support at 5 km/h × 1.8 m 30.5 ms long (limit 30): the
-/// earlier retraction slows the heel earlier, and the foot-speed detector sees the contact
-/// earlier.
-///
-/// The path's hip torque is the one that gives the thigh the path's acceleration (the knee's
-/// torque given), corrected by the paper's spring–damper (`SwingSpec::hip_spring`, per unit of
-/// the straight leg's inertia) on the error: the plain spring–damper about a moving set point
-/// lagged it by up to 0.09 rad (gravity, the knee's extension and the brake drag the thigh) and
-/// peaked 2–3 frames later. It replaces klawhover's lead of the set point (`SWING3_LEAD`, the
-/// thigh retracted only in swing3) and the knee brake's hip share (`KNEE_BRAKE_HIP_RATIO`, the
-/// hamstrings taking the knee's momentum out at the hip): the path's torque does both.
+/// Time before heel strike at which the swing thigh reaches its peak flexion and starts to retract,
+/// as a fraction of the gait cycle (two steps, `2·t_step`).
 pub const RETRACTION_CYCLE: f64 = 0.13;
 
 /// Largest share of the time from the end of swing1 to heel strike that the retraction of the
-/// thigh's terminal-swing path (`ThighPath`) may take; the rest stops the thigh's flexion
-/// (from its rate at the end of swing1, 1–5 rad/s). Binds at 1–2 km/h only. 0.8 and 0.85
-/// raised 2 km/h × 1.8 m's worst continuity ratio 2.82 → 3.8 (the knee in swing2).
+/// thigh's terminal-swing path (`ThighPath`) may take.
 pub const RETRACTION_SHARE_MAX: f64 = 0.75;
 
-/// Power `n` of the retraction of the thigh's terminal-swing path (`ThighPath`):
-/// `θ = θ_peak + Δ·vⁿ`, `v` the fraction of the retraction's time `T_r`, so its rate rises from
-/// rest into the landing rate `θ̇3_hs = n·Δ/T_r`. Measured against 3 and 5: 3 retracts
-/// faster early (the heel slows earlier: `klaw_events`' default double support at 5 km/h ×
-/// 1.8 m 28.6–30.5 ms long, limit 30), 5 brought back a 31 mm rise of the heel before contact
-/// at 5 km/h × 1.8 m; 4 gives 26.0 ms.
+/// Power `n` of the retraction of the thigh's terminal-swing path (`ThighPath`).
 pub const RETRACTION_POWER: f64 = 4.0;
 
 /// The swing thigh's terminal-swing path from the end of swing1 (`t1`, where swing1 left it:
@@ -591,26 +246,15 @@ fn hermite(a: f64, b: f64, p0: [f64; 2], p1: [f64; 2], t: f64) -> [f64; 3] {
 }
 
 /// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
-const PEAK_AT: f64 = 0.3;
+pub(super) const PEAK_AT: f64 = 0.3;
 
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;
 
-/// Largest ankle lift of swing1's curve per metre of the ankle's travel `D`. Not in the paper
-/// (its lift is fixed): in a short half step (the last one of a slow stop, D ≈ 16 cm) the slow
-/// walk's 7 cm lift made the curve fall about along the circle the ankle can reach about the
-/// knee, and the slaved knee slid the ankle 10 cm along it in 11 ms. Steady walks' D is long
-/// enough that this binds only marginally (1 km/h).
+/// Largest ankle lift of swing1's curve per metre of the ankle's travel `D`.
 const LIFT_PER_TRAVEL: f64 = 0.25;
 
-/// Speed below which the ankle curve's lift stops growing as 1/speed, m/s (3 km/h; was
-/// 0.5 m/s). At 1 km/h the lift was 5.7 cm (the travel cap) on a 23 cm travel, and near the end of
-/// swing1 the slaved ankle raced down the curve's steep far flank: knee rate 1.8 → −8.4 →
-/// 1.3 rad/s within 50 ms, ankle 1.5 → 4.9 → 1.6 m/s (knee continuity ratio 6.5 every swing).
-/// With 4.2 cm that is gone (1 km/h 1.8 m: offenders > 5 from 16 to 8, none in swing1; 2 km/h
-/// 1.5 m: 22 to 6), and walks from 3 km/h up are unchanged. A tighter travel cap (0.15) did the
-/// same for steady walks but broke the first half step from standing (ratios > 1000). The
-/// swing1 clearance rounds still raise the curve where the toe needs it.
+/// Speed below which the ankle curve's lift stops growing as 1/speed, m/s (3 km/h; was 0.5 m/s).
 const LIFT_SPEED_MIN: f64 = 3.0 / 3.6;
 
 impl SwingSpec<'_> {
@@ -1309,146 +953,8 @@ impl Hasher for TimeHasher {
     }
 }
 
-/// The knee angle θ4 that puts the ankle, on the circle of radius `l4` about the knee `k`
-/// with the thigh at `th3`, on `curve`, continuing the branch of `guess`.
-///
-/// The root is Newton's from `guess` when it lies on the knee's branch: the ankle residual
-/// `F(θ4) = a_y − P(a_x)` rises with θ4 there (the ankle crosses the curve from below as the knee
-/// flexes: the transversality `sin(φ − ψ)` of [`REACH_SHARE`] is positive) and the root is within
-/// [`KNEE_BRANCH_STEP`] of `guess`. Otherwise, the extremum of `F` next to `guess`
-/// (`∂F/∂θ4 = 0`, where the circle runs parallel to the curve) tells which case it is: where it
-/// is a minimum below zero (or a maximum above), the branch's root lies on its rising side and is
-/// found there by bisection (near a fold Newton can overshoot onto the partner root); where it
-/// is not, the curve has left the ankle's reach about the knee (past a fold, where the branch's
-/// root merged with its partner and vanished) and the ankle is put at that extremum, the point
-/// of its circle nearest the curve. At the fold that is where the lost root was, so the knee
-/// moves on continuously, and when the curve comes back within reach the root re-emerges
-/// there. Failing all (no extremum within [`KNEE_BRANCH_STEP`]) the knee is held at `guess`.
-/// Before this guard Newton went to whatever root it found.
-pub fn knee_on_circle(k: [f64; 2], l4: f64, th3: f64, curve: &AnkleCurve, guess: f64) -> f64 {
-    // F and ∂F/∂θ4 (the ankle moves by l4·(−cos, sin)(θ3 + θ4) per radian of knee flexion).
-    let res = |th4: f64| {
-        let (s, c) = (th3 + th4).sin_cos();
-        let ax = k[0] - l4 * s;
-        let (y, dy) = curve.eval(ax);
-        (k[1] - l4 * c - y, l4 * (s + dy * c), ax, s, c, dy)
-    };
-    let (th4, _) = damped_newton(guess, 0.2, |t| {
-        let (f, df, ..) = res(t);
-        (f, df)
-    });
-    let (f, df, ..) = res(th4);
-    if f.abs() < 1e-9 && df > 0.0 && (th4 - guess).abs() <= KNEE_BRANCH_STEP {
-        return th4;
-    }
-    // Newton missed the branch (near a fold it can overshoot onto the partner root). The
-    // extremum of F next to `guess`: Newton on ∂F/∂θ4 = l4·(s + P'·c) = 0.
-    let (ext, curv) = damped_newton(guess, 0.05, |e| {
-        let (_, g, ax, s, c, dy) = res(e);
-        (g, l4 * (c - dy * s - l4 * c * c * curve.curvature(ax)))
-    });
-    let (fe, g, ..) = res(ext);
-    if !(g.abs() < 1e-9 && ext.is_finite() && (ext - guess).abs() <= KNEE_BRANCH_STEP) {
-        return guess;
-    }
-    // The branch's root (F rising through 0) next to the extremum: above a minimum below 0,
-    // below a maximum above 0; else the curve is out of reach and the extremum is the point
-    // nearest it.
-    let dir = if curv > 0.0 && fe < 0.0 {
-        1.0
-    } else if curv < 0.0 && fe > 0.0 {
-        -1.0
-    } else {
-        return ext;
-    };
-    let (mut a, mut b) = (ext, ext);
-    let mut width = 1e-3;
-    while width <= 2.0 * KNEE_BRANCH_STEP {
-        b = ext + dir * width;
-        if res(b).0 * dir > 0.0 {
-            break;
-        }
-        a = b;
-        width *= 2.0;
-    }
-    if res(b).0 * dir <= 0.0 {
-        return ext;
-    }
-    for _ in 0..60 {
-        let m = 0.5 * (a + b);
-        if res(m).0 * dir > 0.0 {
-            b = m;
-        } else {
-            a = m;
-        }
-    }
-    let root = 0.5 * (a + b);
-    if (root - guess).abs() <= KNEE_BRANCH_STEP {
-        root
-    } else {
-        ext
-    }
-}
-
-/// Damped Newton for a root of `f` (value, derivative) from `x`, each step at most `max_step`
-/// (at most 30 steps; stops on a vanishing derivative or a step under 1e-14). Returns the last
-/// iterate and the derivative last evaluated.
-fn damped_newton(mut x: f64, max_step: f64, f: impl Fn(f64) -> (f64, f64)) -> (f64, f64) {
-    let mut d = 0.0;
-    for _ in 0..30 {
-        let (v, dv) = f(x);
-        d = dv;
-        if dv.abs() < 1e-12 {
-            break;
-        }
-        let step = (v / dv).clamp(-max_step, max_step);
-        x -= step;
-        if step.abs() < 1e-14 {
-            break;
-        }
-    }
-    (x, d)
-}
-
-/// Largest change of the slaved swing1 knee between two evaluations of [`knee_on_circle`]
-/// (at most one integration step apart, ≤ 5 ms), rad: a root further from the last knee is on
-/// another branch. With the curve's flank kept off the reach circle's tangent
-/// ([`REACH_SHARE`]) the knee moves far less than that per step.
-pub const KNEE_BRANCH_STEP: f64 = 0.25;
-
-/// Least share of the shank's inclination kept between swing1's ankle curve `P` and the circle
-/// the ankle can reach about the knee: the curve's angle of descent `ψ = −atan P'` where the
-/// ankle is may be at most `(1 − REACH_SHARE)·φ`, `φ = θ3 + θ4` the shank's inclination from the
-/// vertical (the ankle behind the knee); the transversality `sin(φ − ψ)` is then at least
-/// `sin(REACH_SHARE·φ)`.
-///
-/// Derivation (the condition for the slaved knee to keep its root). In swing1 the thigh θ3 is
-/// driven by the dynamics, so the knee `k(t)` is given, and the ankle must lie both on the
-/// circle of radius `l4` about `k` and on `P`. The residual `F(θ4) = a_y − P(a_x)` has
-/// `∂F/∂θ4 = l4·(sin φ + P'·cos φ) = l4·√(1 + P'²)·sin(φ − ψ)`: the root is regular, and
-/// moves continuously with the knee, exactly while `φ > ψ` (a knee extension moves the ankle
-/// forward and down at `φ` below the horizontal, so it can follow a descent only less steep than
-/// that). The ankle's speed along the curve is `|v_k · r| / sin(φ − ψ)` (`r` the unit shank,
-/// `v_k` the knee's velocity): as `φ − ψ → 0` the ankle races down the flank (a near-fold:
-/// knee 188 rad/s for 4 ms), and beyond it the root is lost. Leaving the hip's reach annulus
-/// (`|l3 − l4| ≤ |a − h| ≤ l3 + l4`) is *not* what happens: the fold comes first, on the
-/// falling flank late in swing1 (60–90 % of `D`, where `ψ` is largest while the thigh is
-/// nearly forward), with the ankle well inside the annulus.
-///
-/// Where it gets small (measured along the simulated swing1): a short travel `D`, a toe-off
-/// ankle high above its landing height (a slow step after fast ones) and a large lift (slow
-/// walks) steepen the flank, and a short step's shank is less inclined at the end of swing1.
-/// Steady walks 1–7 km/h × 1.5–2.0 m keep `sin(φ − ψ)` at 0.21–0.47 (least at 1 km/h, rising
-/// with speed). With §4.3's peak (`max(a0, a_min) + lift`): slowing 7 → 1 km/h (the stop's half
-/// step, its ankle leaving 8 cm above its landing height on a 0.29 m travel) 0.003–0.016
-/// (continuity 11–73); 2 km/h steady walks 0.18 (4.0–4.5; 0.27 → 3.2–3.4); the first swing from
-/// standing into 6 → 1 km/h × 1.6 m 0.18 at φ = 0.37 (knee 5.2). 0.6 (the flank descends at
-/// most 40 % as steeply, in angle, as the shank leans; `sin(φ − ψ) ≥ 0.35` at the usual
-/// φ ≈ 0.6, an ankle speed at most 2.9× the knee's along the shank) was measured against 0.5
-/// (leaves the last case at 5.2) and a fixed `sin(φ − ψ) ≥ 0.2, 0.25, 0.3` (2 km/h 4.0–4.2,
-/// 3.4–3.7, 3.2–3.4 and the first-swing case 5.2); it leaves every steady walk and the
-/// schedule 2 → 5 → 3 km/h as they were (1 km/h × 1.8 m 3.31 → 3.25), and it replaces the tuned
-/// `LIFT_OVER_TOE_OFF` (0.25 of the lift over a high toe-off ankle) by §4.3's own peak.
+/// Least share of the shank's inclination kept between swing1's ankle curve `P` and the circle the
+/// ankle can reach about the knee.
 pub const REACH_SHARE: f64 = 0.6;
 
 /// Largest number of swing1 repeats with the peak bounded by `reach_curve`.
@@ -1571,198 +1077,6 @@ pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
 mod tests {
     use super::*;
 
-    fn test_swing_foot(rate: f64) -> SwingFoot {
-        let body = Body::from_height(1.8, 75.0).unwrap();
-        SwingFoot {
-            foot: FootShape::new(&body),
-            times: [0.1, 0.3, 0.44, 0.5],
-            theta5: [1.2, 1.75, 1.6],
-            theta6_toe_off: 0.3,
-            clearance: 0.005,
-            theta5_max: 2.0,
-            theta5_rate_hs: rate,
-            contact_ramp_weight: 1.0,
-        }
-    }
-
-    #[test]
-    fn swing_ankle_ends_with_the_contact_rate_and_keeps_its_ends() {
-        let plain = test_swing_foot(0.0);
-        let th = |f: &SwingFoot, t: f64| f.theta56(t).0;
-        let e = 1e-6;
-        let rate = |f: &SwingFoot, t: f64| (th(f, t + e) - th(f, t - e)) / (2.0 * e);
-        let end_rate = |f: &SwingFoot| (th(f, 0.5) - th(f, 0.5 - e)) / e;
-        // The plain interpolation comes to rest at heel strike.
-        assert!(end_rate(&plain).abs() < 1e-3, "{}", end_rate(&plain));
-        for r in [-6.0, -3.0, -1.0, 2.0] {
-            let f = test_swing_foot(r);
-            // Unchanged through swing1, C¹ at its end; the heel-strike value kept, reached
-            // at the contact rate.
-            for t in [0.1, 0.2, 0.3] {
-                assert_eq!(th(&f, t), th(&plain, t), "{r}: {t}");
-            }
-            assert!(
-                (rate(&f, 0.3 + e) - rate(&plain, 0.3 + e)).abs() < 1e-4,
-                "{r}"
-            );
-            assert!((th(&f, 0.5) - 1.6).abs() < 1e-12, "{r}");
-            assert!((end_rate(&f) - r).abs() < 1e-3, "{r}: {}", end_rate(&f));
-        }
-        // At the full contact rate the ankle plantarflexes monotonically from its mid-swing
-        // value to its heel-strike value (no dorsiflexion bump, as the swing3 cubic alone
-        // made: 4/27 · |ṙ| · T3 beyond the plain interpolation), and its steps at 100 fps rise
-        // frame by frame into the contact.
-        let f = test_swing_foot(-super::super::generate::MAX_CONTACT_ANKLE_RATE);
-        let mut last = th(&f, 0.3);
-        for i in 1..=200 {
-            let v = th(&f, 0.3 + 0.2 * i as f64 / 200.0);
-            assert!(
-                v <= last + 1e-15 && (1.6 - 1e-15..=1.75).contains(&v),
-                "{i}: {v}"
-            );
-            last = v;
-        }
-        let steps: Vec<f64> = (0..6)
-            .map(|k| th(&f, 0.5 - 0.01 * (k + 1) as f64) - th(&f, 0.5 - 0.01 * k as f64))
-            .collect();
-        for k in 0..5 {
-            assert!(steps[k] > steps[k + 1] && steps[k + 1] > 0.0, "{steps:?}");
-        }
-        // The ramp alone below s = 2 is the cubic Hermite of the same ends.
-        let g = test_swing_foot(-1.0);
-        let u = 0.4;
-        let herm = 1.75 - 0.15 * (3.0 - 2.0 * u) * u * u - 0.2 * (u - 1.0) * u * u;
-        assert!((g.contact_ramp(0.3 + 0.2 * u) - herm).abs() < 1e-12);
-    }
-
-    #[test]
-    fn swing_foot_takes_up_the_clearance_without_a_kink() {
-        // The ankle held low and still, the shank vertical: early in swing1 the plantarflexed
-        // interpolated foot would put its toe in the ground, so the clearance pitches it up,
-        // until the interpolation dorsiflexes it past that.
-        let body = Body::from_height(1.8, 75.0).unwrap();
-        let sf = SwingFoot {
-            foot: FootShape::new(&body),
-            times: [0.0, 0.2, 0.34, 0.4],
-            theta5: [1.3, 1.65, 1.57],
-            theta6_toe_off: 0.3,
-            clearance: 0.01,
-            theta5_max: 115f64.to_radians(),
-            theta5_rate_hs: 0.0,
-            contact_ramp_weight: 0.0,
-        };
-        let ankle = [0.0, body.l9 + 0.005];
-        let h = 5e-4;
-        let ts: Vec<f64> = (0..=400).map(|i| i as f64 * h).collect();
-        let pitch: Vec<f64> = ts.iter().map(|&t| sf.pose(t, ankle, 0.0).0).collect();
-        let interp: Vec<f64> = ts.iter().map(|&t| sf.theta56(t).0 - FRAC_PI_2).collect();
-        let mut lifted = 0.0f64;
-        for (i, &t) in ts.iter().enumerate() {
-            // Never below the interpolation, the clearance kept (it ramps in over 30 % of
-            // swing1).
-            assert!(
-                pitch[i] >= interp[i] - 1e-12,
-                "below the interpolation at {t}"
-            );
-            let need = sf.clearance * smoothstep(t / (0.3 * 0.2));
-            let p = sf.points(t, ankle, 0.0);
-            assert!(
-                p.toe[1].min(p.ball[1]) >= need - 1e-9,
-                "toe {} ball {} below {need} at {t}",
-                p.toe[1],
-                p.ball[1]
-            );
-            lifted = lifted.max(pitch[i] - interp[i]);
-        }
-        assert!(lifted > 0.1, "the clearance must act here: {lifted}");
-        // C¹: the pitch's rate changes by a bounded amount per sample where the clearance takes
-        // over and lets go (a hard maximum jumps by the difference of the two rates there).
-        let rate: Vec<f64> = pitch.windows(2).map(|w| (w[1] - w[0]) / h).collect();
-        let jump = rate
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .fold(0.0, f64::max);
-        let hard: Vec<f64> = ts
-            .iter()
-            .zip(&interp)
-            .map(|(&t, &pi)| {
-                let need = sf.clearance * smoothstep(t / (0.3 * 0.2));
-                let (mut lo, mut hi) = (pi - 1.0, pi + 1.0);
-                for _ in 0..60 {
-                    let m = 0.5 * (lo + hi);
-                    let p = sf.foot.points(ankle, m, sf.theta56(t).1);
-                    if p.toe[1].min(p.ball[1]) >= need {
-                        hi = m;
-                    } else {
-                        lo = m;
-                    }
-                }
-                pi.max(hi)
-            })
-            .collect();
-        let hard_rate: Vec<f64> = hard.windows(2).map(|w| (w[1] - w[0]) / h).collect();
-        let hard_jump = hard_rate
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .fold(0.0, f64::max);
-        assert!(
-            jump < 0.2 * hard_jump,
-            "rate jump {jump} rad/s vs {hard_jump} with a hard maximum"
-        );
-    }
-
-    #[test]
-    fn the_slaved_knee_follows_its_branch_past_a_fold() {
-        // The ankle held on a straight flank descending at ψ = 0.5 rad; the knee (thigh fixed)
-        // moves away from it, perpendicular, from 0.3 m to 0.6 m and back (shank 0.45 m). While
-        // the flank is within reach the ankle is on it, on the knee's branch (φ > ψ); beyond,
-        // no root exists and the ankle is at the circle's point nearest the flank (φ = ψ, where
-        // the two roots merged); the knee never jumps, and comes back onto its branch.
-        let psi: f64 = 0.5;
-        let line = AnkleCurve {
-            c: [0.0, -psi.tan(), 0.0, 0.0, 0.0],
-            x0: 0.0,
-            d: 1.0,
-            heights: [0.0; 3],
-        };
-        let (l4, th3) = (0.45, -0.2);
-        let normal = [psi.sin(), psi.cos()];
-        let foot = [0.4, -0.4 * psi.tan()];
-        let n = 3000;
-        let dists: Vec<f64> = (0..=2 * n)
-            .map(|i| 0.3 + 0.3 * (1.0 - (i as f64 / n as f64 - 1.0).abs()))
-            .collect();
-        let mut th4 = {
-            // Start on the branch: φ − ψ = acos(0.3/0.45).
-            (0.3f64 / l4).acos() + psi - th3
-        };
-        let (mut lost, mut on) = (0, 0);
-        for &dist in &dists {
-            let k = [foot[0] + dist * normal[0], foot[1] + dist * normal[1]];
-            let next = knee_on_circle(k, l4, th3, &line, th4);
-            assert!((next - th4).abs() < 0.03, "jump {th4} -> {next} at {dist}");
-            th4 = next;
-            let phi = th3 + th4;
-            let ankle = [k[0] - l4 * phi.sin(), k[1] - l4 * phi.cos()];
-            let f = ankle[1] - line.eval(ankle[0]).0;
-            if dist < l4 - 1e-3 {
-                assert!(
-                    f.abs() < 1e-9 && phi > psi,
-                    "off the branch at {dist}: {f} {phi}"
-                );
-                on += 1;
-            } else if dist > l4 + 1e-3 {
-                assert!(
-                    (phi - psi).abs() < 1e-6,
-                    "not the nearest point at {dist}: {phi}"
-                );
-                assert!((f * psi.cos() - (dist - l4)).abs() < 1e-9, "{f} at {dist}");
-                lost += 1;
-            }
-        }
-        assert!(lost > 1000 && on > 1000, "{lost} {on}");
-    }
-
     #[test]
     fn the_reach_bound_lowers_the_peak_then_moves_it_towards_toe_off() {
         let tan = |phi: f64| ((1.0 - REACH_SHARE) * phi).tan();
@@ -1815,28 +1129,5 @@ mod tests {
         let c = reach_curve(0.0, d, a0, a0 + 0.04, a_min, &samples(d, 0.62)).unwrap();
         check(&c, a0, a_min, d, 0.62);
         assert!(c.eval(0.3 * d).1.abs() < 1e-12 && c.heights[1] < a0 + 0.04);
-    }
-
-    #[test]
-    fn the_level_curves_join_the_papers_and_lose_their_peak() {
-        let (d, a0, a_min) = (0.4, 0.2, 0.1);
-        // At γ = 0.3: §4.3's quartic with the peak for which y'(0) = 0 (H = 1.115·A0).
-        let at = AnkleCurve::fit_level(0.0, d, PEAK_AT, a0, a_min).unwrap();
-        let paper = AnkleCurve::fit(0.0, d, a0, at.heights[1], a_min).unwrap();
-        for i in 0..=20 {
-            let x = d * i as f64 / 20.0;
-            assert!((at.eval(x).0 - paper.eval(x).0).abs() < 1e-12);
-        }
-        assert!(paper.eval(0.0).1.abs() < 1e-12);
-        let h = (at.heights[1] - a_min) / (a0 - a_min);
-        assert!((h - 1.115).abs() < 1e-3, "{h}");
-        // At γ = 0: a_min + A0·(1 − 4u³ + 3u⁴), monotone.
-        let flat = AnkleCurve::fit_level(0.0, d, 0.0, a0, a_min).unwrap();
-        for i in 0..=20 {
-            let u = i as f64 / 20.0;
-            let want = a_min + (a0 - a_min) * (1.0 - 4.0 * u.powi(3) + 3.0 * u.powi(4));
-            assert!((flat.eval(u * d).0 - want).abs() < 1e-12);
-            assert!(flat.eval(u * d).1 <= 1e-12);
-        }
     }
 }

@@ -95,6 +95,26 @@ impl<const N: usize> Track<N> {
     }
 }
 
+/// Linear interpolation of `(t, ρ)` roll samples at `t`, held at the end values outside them
+/// (the walk's frames and the stop read the virtual legs' recorded rolls this way).
+pub fn interp_rho(samples: &[(f64, f64)], t: f64) -> f64 {
+    if samples.is_empty() {
+        return 0.0;
+    }
+    let k = samples.partition_point(|s| s.0 <= t);
+    if k == 0 {
+        return samples[0].1;
+    }
+    if k >= samples.len() {
+        return samples[samples.len() - 1].1;
+    }
+    let (a, b) = (samples[k - 1], samples[k]);
+    if b.0 == a.0 {
+        return b.1;
+    }
+    a.1 + (b.1 - a.1) * (t - a.0) / (b.0 - a.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

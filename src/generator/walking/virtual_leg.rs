@@ -24,6 +24,7 @@
 //! in 3D reaches its ankle exactly.
 use super::attributes::WalkAttributes;
 use super::body::Body;
+pub use super::draw::smooth_roll;
 use super::foot::{toe_blend, FootShape};
 use crate::generator::curves::smoothstep;
 use std::f64::consts::FRAC_PI_2;
@@ -32,126 +33,31 @@ use std::f64::consts::FRAC_PI_2;
 pub const KNEE_SOFT: f64 = 0.0015;
 
 /// Time constant of the knee's eased straightening after foot flat, s.
-///
-/// Why: in slow walks (1–2 km/h) the hip never comes much below the straight leg, so the planned
-/// heel rocker lands the foot with the knee still flexing (up to 0.034 rad/frame at 1 km/h ×
-/// 1.5 m) at the shortest point of its pass; the flat-foot and heel-off rules then straighten
-/// the knee as the hip–ankle distance grows, and near straight (θ4 ∝ √(l1 − d)) that took the
-/// knee from flexing to straightening at 0.011–0.025 rad/frame within 1–2 frames and back to
-/// rest within 3–4 (continuity ratios 6–8.5 on the knee at heel off). The knee instead follows
-/// the rule's knee from above as a critically damped second-order system with this time
-/// constant: never less flexed than the rule (a more flexed knee only asks the foot to roll
-/// a little earlier, so the ankle stays in reach), C¹ through its peak and its return to rest.
-/// The walk's rocker landings now ease from their own knee and rate instead
-/// ([`KNEE_ROCKER_EASE`]); this ease is what [`VirtualLeg::knee_ease`] does without that state.
 pub const KNEE_EASE: f64 = 0.015;
 
-/// Time constant of the knee's ease from a straight-leg landing, s: where no heel rocker could be
-/// planned (slow walks whose hip never comes within the straight leg's reach of the flat ankle)
-/// the straight leg lands the foot with the knee straight and at rest, and the flat and heel-off
-/// rules then asked for the soft leg length `l − σ` in the same frame — a knee flexion of
-/// ≈ 0.11 rad in one frame (foot flat and heel off in one frame; continuity 111.9 at 1 → 1.5
-/// km/h × 2.0 m). The knee instead leaves straight at rest as a critically damped second-order
-/// system with this time constant, from below as well as from above the rule's knee (a
-/// straighter knee only lets the foot roll a little later; it is always in reach).
+/// Time constant of the knee's ease from a straight-leg landing, s.
 pub const KNEE_LAND_EASE: f64 = 0.03;
 
-/// Time constant of the knee's ease after a planned heel rocker's landing that narrowed the
-/// knee's soft margin ([`VirtualLeg::knee_soft`] below [`KNEE_SOFT`]: slow walks), s. The ease
-/// starts from the rocker's knee *and its rate* at foot flat ([`HeelRocker::knee_end`]) and
-/// follows the flat and heel-off rules' knee from either side, as a critically damped
-/// second-order system (a straighter knee only keeps the foot flat a little longer).
-///
-/// Why: such a rocker lands where the flat foot's knee is still straightening fast (it is
-/// met with that rate), 2.9–3.4 rad/s at 1 km/h × 1.7 m, 0.4 mm short of the straight leg;
-/// the rule's soft blend is 2σ = 0.4 mm wide there, so its knee stops within one 10 ms frame,
-/// and the former ease (from the rule's knee at rest, [`KNEE_EASE`], only from the more flexed
-/// side) threw the landing's rate away: the foot had to roll at once (foot flat and heel off
-/// 2 ms apart) and the heel left the floor at 0.7 mm/frame from rest (continuity 6.3–6.9 at
-/// 1 km/h × 1.7 m; switching the ease off moved the jump to the knee, 6.1–6.7). Carrying the
-/// rate on, the knee decelerates over ≈ 4 frames, straightening to near straight (the
-/// least flexion the soft rule allows is not a floor for it) and settling back on the rule's
-/// knee, and the heel starts from rest. Measured (1 km/h × 1.7 m from standing with a stop,
-/// `1x8` / `5x4,1x6` / `6x4,1x6`, 6.73/6.86/6.30 before): 15 ms 4.85/4.88/4.76, 30 ms
-/// 3.83/3.72/4.08 but 1 km/h × 1.8 m 3.27 → 4.18, 50 ms 3.83/3.52/4.08 and 1.8 m unchanged.
-/// Easing every rocker's knee this way (not only narrowed ones) spoiled faster walks (7 km/h ×
-/// 1.5 m 5.29 → 18.1, 4 km/h × 1.5 m 3.75 → 5.22); easing only the landings below
-/// [`KNEE_EASE_SOFT`] left 1 km/h × 1.6 m's knee stopping dead at heel off (6.81; its landing
-/// narrows the margin to ≈ 0.6 mm). Cost: where the landing knee still *flexes* (1 km/h ×
-/// 1.5 m, ≈ 4 rad/s) the ease carries it on past the rule's peak (0.18 rad against 0.135), the
-/// foot rolled for it and, its roll never decreasing, kept the heel 4.07 mm up through
-/// midstance (2.32 mm before; 1.8/2.0 m unchanged, 3.17/3.52). A 15 ms ease for flexing
-/// landings only, or no rocker ease for them, put 1 km/h × 1.5 m from standing at 5.25, 1.5
-/// km/h × 1.5 m at 6.27 (steady) or left 1.6 m at 6.81.
-///
-/// While the foot is flat the eased knee is now never more flexed than the flat foot's rule
-/// allows (its span never shorter than the rule's): the ease may carry the landing's rate on,
-/// but not roll the foot onto its ball. Since the slowest stances lower the hip
-/// (`generate::SLOW_REST_REACH`) the overshoot lifted the heel at foot flat in one walk of
-/// 1.0–2.0 km/h every 0.1 × 1.5–2.0 m every 5 cm (1.4 km/h × 1.6 m, whose rocker lands with the
-/// knee flexing at 4.9 rad/s: heel off at foot flat, 3.98 mm through midstance); with the bound
-/// its heel stays down until 4 frames before its heel off, continuity 3.25 → 3.47; every other
-/// walk of the dense grids (1–7 km/h, 1232 walks) and the 243-walk sweep is unchanged.
+/// Time constant of the knee's ease after a planned heel rocker's landing that narrowed the knee's
+/// soft margin ([`VirtualLeg::knee_soft`] below [`KNEE_SOFT`]: slow walks), s.
 pub const KNEE_ROCKER_EASE: f64 = 0.05;
 
 /// The knee was eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
-/// margin ([`VirtualLeg::knee_soft`]) below this, m: a landing within 0.33 mm of the straight
-/// leg (every narrowed landing is now eased, [`KNEE_ROCKER_EASE`]; the landing choice of
-/// [`VirtualLeg::plan_heel_rocker`] still tells nearly straight landings apart by this). Measured (8 steps): 1 km/h lands at 0.04–0.30 mm, 2 km/h at 0.41–0.67 mm after its
-/// first step, 3 km/h and faster at the full [`KNEE_SOFT`]. Easing every leg made the heel
-/// start rising from rest at speed at 3 km/h (ratios 3.8 → 7.1–8.6) and 2 km/h × 2.0 m's
-/// elbows worse (6.0 → 7.3); above this threshold their rules' knees are smooth already.
+/// margin ([`VirtualLeg::knee_soft`]) below this, m.
 pub const KNEE_EASE_SOFT: f64 = 0.00033;
 
-/// How many landing times after the shortest valid one [`VirtualLeg::plan_heel_rocker`] also
-/// tries (on its ×1.1 grid: up to ≈ 1.5 × the shortest), keeping the one whose knee Hermite
-/// has the least peak acceleration `max(|k̈(0)|, |k̈(T)|)` (a cubic's second derivative is
-/// linear, so its peak is at an end).
-///
-/// Why: the shortest landing meets the flat foot's knee where that knee rises fastest — just
-/// after the hip comes within the leg's reach of the flat ankle, where a knee near straight
-/// rises as √(l1 − d). The Hermite then had to end at 3–4 × its mean rate: in slow walks the
-/// knee flexed a little at contact, stalled, and surged at foot flat (2 km/h, 1.8 m: knee
-/// 0.006 rad in the first frame against a median of 0.00004, then 0.017 → 0.062 rad/frame at
-/// foot flat, and the hip and the opposite arm jolted there; continuity 6.3–6.8). A landing a
-/// few frames later meets the flat knee past that onset. Measured (8 steps, 1.5/1.8/2.0 m):
-/// 2 km/h 6.29/6.77/6.83 → 4.52/6.35/5.22, 5 km/h 1.5 m 12.1 (frame 0) → 9.8; 7 km/h 1.8 m
-/// 10.57 → 10.75; the other walks unchanged. A landing that would switch the knee ease
-/// ([`KNEE_EASE_SOFT`]) on or off against the shortest's is not taken (1 km/h × 1.5 m 4.6 →
-/// 6.9 otherwise), unless the kept one's knee leaves heel strike at ≥ 2 × its mean rate (1 → 7
-/// km/h × 2.0 m 26.85 → 4.58 with the exception) or flexes, straightens and flexes again inside
-/// the rocker and the other is [`DIP_TRADE`] × gentler (the first slower step of a slow-down:
-/// 3 → 1 km/h × 1.8 m 10.6 → 4.2).
+/// How many landing times after the shortest valid one [`VirtualLeg::plan_heel_rocker`] also tries
+/// (on its ×1.1 grid: up to ≈ 1.5 × the shortest), keeping the one whose knee Hermite has the least
+/// peak acceleration `max(|k̈(0)|, |k̈(T)|)` (a cubic's second derivative is linear, so its peak is
+/// at an end).
 pub const ROCKER_SCAN: usize = 4;
 
-/// How much gentler (peak knee acceleration, [`ROCKER_SCAN`]'s cost) a landing must be to replace
-/// a kept landing whose knee dips (flexes, straightens and flexes again) against the knee-ease
-/// rule there.
-///
-/// Why: a dipping knee is a jolt at heel strike or foot flat wherever it is kept. The first
-/// slower stance of a slow-down trades it for a landing 21–700 × gentler (3 → 1 km/h × 1.8 m
-/// 10.6 → 4.2); between the tested speeds and heights the gentler landings are only 4–9 ×
-/// gentler (1.3 km/h × 1.5 m: the dipping landing 349, the others 76, 104, 37, 78), and at the
-/// former 10 the dip was kept. Measured, 1.0–2.5 km/h every 0.05 × 1.5–2.0 m every 5 cm, 8 steps
-/// (341 walks), walks over k = 5 and the worst ratio: 10 → 17 (11.35), 5 → 3 (8.13), 4, 3, 2.5, 2
-/// and 1.5 → none (4.78, the same walks identical from 4 down); from standing with a stop, every
-/// 0.1 km/h (176 walks): 15 (12.43) → 1 (5.14, the stop's landing ankle, which this does not
-/// touch). Above 2.5 km/h nothing changed (2.5–7 km/h every 0.1, 506 walks). 3 sits in the
-/// middle of that plateau. (At 5.3 × it had once made 1 km/h × 1.7 m's knee straighten abruptly
-/// at heel off, 6.0 → 7.35; that was before meta-off started from the heel-off roll: now 3.72 →
-/// 3.15.) Tested by `slow_walks_between_the_grid_points_meet_k5` in `tests/klaw_continuity.rs`.
+/// How much gentler (peak knee acceleration, [`ROCKER_SCAN`]'s cost) a landing must be to replace a
+/// kept landing whose knee dips (flexes, straightens and flexes again) against the knee-ease rule
+/// there.
 pub const DIP_TRADE: f64 = 3.0;
 
-/// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow):
-/// the meta-off knee blend ends at this rate instead of at rest.
-///
-/// Why: a knee that comes to rest at toe-off starts the swing with almost no speed; the toe
-/// then stayed within 5 mm of the floor, at less than a quarter of the walking speed, for
-/// 50–170 ms in slow walks, and gaitfit's default (foot-speed) events saw the double support
-/// +43 % (1.5 km/h) and +28 % (3 km/h) too long. A human knee flexes at about 5–8 rad/s around
-/// toe-off (its peak flexion velocity comes just after it). Measured with the swing's knee
-/// brake (default events, toe off late by): 6 rad/s 18/13 ms at 1.5/3 km/h, 8 rad/s 9/4 ms
-/// (the double support within 23 and 9 ms of t_ds).
+/// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow).
 pub const TOE_OFF_KNEE_RATE: f64 = 8.0;
 
 /// How far the foot may roll about the toe tip beyond the toe-bend limit, rad (80°).
@@ -298,11 +204,7 @@ impl HeelRocker {
 
 /// Knee flexion of a two-link leg (`l3`, `l4`) spanning `d`, rad.
 fn knee_for(l3: f64, l4: f64, d: f64) -> f64 {
-    let dc = d.clamp((l3 - l4).abs() + 1e-12, l3 + l4);
-    std::f64::consts::PI
-        - ((l3 * l3 + l4 * l4 - dc * dc) / (2.0 * l3 * l4))
-            .clamp(-1.0, 1.0)
-            .acos()
+    crate::generator::ik::flexion_for_span(l3, l4, d)
 }
 
 /// Whether the heel rocker's knee Hermite (from straight at rate `r0` to `k_end` at rate `r1`
@@ -323,164 +225,7 @@ fn knee_dips(k_end: f64, big_t: f64, r0: f64, r1: f64) -> bool {
 
 /// Length of a two-link leg with knee flexion `knee`, m.
 fn span_for(l3: f64, l4: f64, knee: f64) -> f64 {
-    (l3 * l3 + l4 * l4 + 2.0 * l3 * l4 * knee.cos())
-        .max(0.0)
-        .sqrt()
-}
-
-/// Smooths the stance foot's roll after it is flat: `rho` (the rule's roll, non-decreasing,
-/// sampled at the increasing `times`) is replaced from sample `from` on by the curve that stays
-/// closest to it while bending least, `min Σ (ρ − rho)² + (τ/h̄)⁴ Σ (h̄² ρ̈)²` (`h̄` the mean
-/// sample spacing, `ρ̈` by divided differences), never below it. The first two samples are kept
-/// (`rest`: the second is set equal to the first — the foot lands flat at rest from the heel
-/// rocker), and so are the last two (toe-off, where the swing takes over, and its rate).
-///
-/// Why: the heel-off rule ("just enough roll to keep the ankle within reach") starts the roll
-/// at the rate the telescopic leg lengthens, and KLAW's leg extends at 0.15–0.25 m/s until it
-/// locks at `l1`: in slow walks the rule raises the heel 2 mm within 15 ms, 20 ms after foot
-/// flat, and then nearly stops (continuity ratios 8–15 on the heel, ankle, metatarsal joint and
-/// knee at 3 km/h). A forward mean (the previous remedy) is never below the rule either, but
-/// its window must shrink to nothing at foot flat to keep the flat foot, so it spread nothing
-/// there. The least-bending curve above the rule starts at rest and spreads the rise over
-/// `τ`-scale times (the knee flexes a little more meanwhile, so the ankle stays in reach). A
-/// penalized cubic-spline smoother with a lower bound: a banded (five diagonals) linear system,
-/// and an active set that pins the deepest sample of each run below the rule to it until none
-/// is left.
-pub fn smooth_roll(times: &[f64], rho: &mut [f64], from: usize, rest: bool, tau: f64) {
-    let n = times.len().min(rho.len());
-    if from + 6 >= n || tau <= 0.0 {
-        return;
-    }
-    let m = n - from;
-    let t = &times[from..n];
-    let target: Vec<f64> = rho[from..n].to_vec();
-    let lo = &target;
-    let hbar = (t[m - 1] - t[0]) / (m - 1) as f64;
-    if hbar.is_nan() || hbar <= 0.0 {
-        return;
-    }
-    let lambda = (tau / hbar).powi(4);
-    // Band storage of the symmetric matrix: a[i] = [A_ii, A_i,i+1, A_i,i+2].
-    let mut base = vec![[1.0f64, 0.0, 0.0]; m];
-    for j in 1..m - 1 {
-        let h0 = (t[j] - t[j - 1]).max(0.1 * hbar);
-        let h1 = (t[j + 1] - t[j]).max(0.1 * hbar);
-        let c0 = 2.0 * hbar * hbar / ((h0 + h1) * h0);
-        let c2 = 2.0 * hbar * hbar / ((h0 + h1) * h1);
-        let c = [c0, -(c0 + c2), c2];
-        for a in 0..3 {
-            for b in a..3 {
-                base[j - 1 + a][b - a] += lambda * c[a] * c[b];
-            }
-        }
-    }
-    let mut fixed: Vec<Option<f64>> = vec![None; m];
-    fixed[0] = Some(target[0]);
-    fixed[1] = Some(if rest { target[0] } else { target[1] });
-    fixed[m - 2] = Some(target[m - 2]);
-    fixed[m - 1] = Some(target[m - 1]);
-    let mut x = target.clone();
-    for _ in 0..60 {
-        x = solve_pinned(&base, &target, &fixed);
-        // The deepest sample of each run below the rule is pinned to it.
-        let mut added = false;
-        let mut i = 0;
-        while i < m {
-            if fixed[i].is_none() && x[i] < lo[i] - 1e-12 {
-                let mut worst = i;
-                let mut j = i;
-                while j < m && fixed[j].is_none() && x[j] < lo[j] - 1e-12 {
-                    if x[j] - lo[j] < x[worst] - lo[worst] {
-                        worst = j;
-                    }
-                    j += 1;
-                }
-                fixed[worst] = Some(lo[worst]);
-                added = true;
-                i = j;
-            } else {
-                i += 1;
-            }
-        }
-        if !added {
-            break;
-        }
-    }
-    rho[from..n].copy_from_slice(&x);
-}
-
-/// Solves `(I + λDᵀD) x = target` (band storage `a`, see [`smooth_roll`]) with the `pinned`
-/// samples held at their values: a banded LDLᵀ factorization, O(n).
-fn solve_pinned(a: &[[f64; 3]], target: &[f64], pinned: &[Option<f64>]) -> Vec<f64> {
-    let m = a.len();
-    let mut band = a.to_vec();
-    let mut rhs = target.to_vec();
-    // Move the pinned samples to the right-hand side and decouple their rows.
-    for k in 0..m {
-        let Some(v) = pinned[k] else { continue };
-        for off in 1..3 {
-            if k + off < m {
-                rhs[k + off] -= band[k][off] * v;
-                band[k][off] = 0.0;
-            }
-            if k >= off {
-                rhs[k - off] -= band[k - off][off] * v;
-                band[k - off][off] = 0.0;
-            }
-        }
-        band[k][0] = 1.0;
-        rhs[k] = v;
-    }
-    for k in 0..m {
-        if let Some(v) = pinned[k] {
-            rhs[k] = v;
-        }
-    }
-    // LDLᵀ with bandwidth 2: l[i] = [L_i,i−1, L_i,i−2].
-    let mut d = vec![0.0; m];
-    let mut l = vec![[0.0f64; 2]; m];
-    for j in 0..m {
-        let mut dj = band[j][0];
-        if j >= 1 {
-            dj -= l[j][0] * l[j][0] * d[j - 1];
-        }
-        if j >= 2 {
-            dj -= l[j][1] * l[j][1] * d[j - 2];
-        }
-        d[j] = dj;
-        if j + 1 < m {
-            let mut v = band[j][1];
-            if j >= 1 {
-                v -= l[j + 1][1] * l[j][0] * d[j - 1];
-            }
-            l[j + 1][0] = v / dj;
-        }
-        if j + 2 < m {
-            l[j + 2][1] = band[j][2] / dj;
-        }
-    }
-    // Forward, diagonal, backward substitution.
-    let mut y = rhs;
-    for i in 0..m {
-        if i >= 1 {
-            y[i] -= l[i][0] * y[i - 1];
-        }
-        if i >= 2 {
-            y[i] -= l[i][1] * y[i - 2];
-        }
-    }
-    for i in 0..m {
-        y[i] /= d[i];
-    }
-    for i in (0..m).rev() {
-        if i + 1 < m {
-            y[i] -= l[i + 1][0] * y[i + 1];
-        }
-        if i + 2 < m {
-            y[i] -= l[i + 2][1] * y[i + 2];
-        }
-    }
-    y
+    crate::generator::ik::span_for_flexion(l3, l4, knee)
 }
 
 /// The root of `g` between `pos` (`g > 0`) and `neg` (`g ≤ 0`), to 1e-10, returned from the
@@ -493,36 +238,16 @@ fn root_nonpositive_side(g: &impl Fn(f64) -> f64, pos: f64, neg: f64) -> f64 {
 /// [`root_nonpositive_side`] from two points whose values of `g` are already known (`ga > 0`,
 /// `gb ≤ 0`): a scan has just evaluated them, and `g` is a pure function, so the answer is the
 /// same without evaluating them twice.
-fn root_from(g: &impl Fn(f64) -> f64, (pos, gpos): (f64, f64), (neg, gneg): (f64, f64)) -> f64 {
-    let (mut a, mut ga) = (pos, gpos);
-    let (mut b, mut gb) = (neg, gneg);
-    let mut side = 0i8;
-    for _ in 0..100 {
-        if (b - a).abs() < 1e-10 || gb == 0.0 {
-            break;
-        }
-        let mut m = (a * gb - b * ga) / (gb - ga);
-        if !(m.is_finite() && (m - a) * (m - b) < 0.0) {
-            m = 0.5 * (a + b);
-        }
-        let gm = g(m);
-        if gm > 0.0 {
-            a = m;
-            ga = gm;
-            if side == 1 {
-                gb *= 0.5;
-            }
-            side = 1;
-        } else {
-            b = m;
-            gb = gm;
-            if side == -1 {
-                ga *= 0.5;
-            }
-            side = -1;
-        }
+fn root_from(g: &impl Fn(f64) -> f64, pos: (f64, f64), neg: (f64, f64)) -> f64 {
+    let stop = crate::generator::numeric::Stop {
+        f_tol: 0.0,
+        x_tol: 1e-10,
+        max_evals: 100,
+    };
+    if pos.1 <= 0.0 {
+        return pos.0;
     }
-    b
+    crate::generator::numeric::illinois(g, pos, neg, stop).b.0
 }
 
 impl VirtualLeg {
@@ -961,21 +686,14 @@ impl VirtualLeg {
             // leg (so the knee straightens before the heel rises, as in late stance). The normal
             // period ends — heel-off begins — when θ5 reaches its dorsiflexion limit or the foot
             // must roll, whichever comes first.
-            // The knee straightens smoothly: the leg's length follows the hip–flat-ankle distance
-            // up to l − 2σ, then a C¹ quadratic blend saturating at l − σ (a knee flexion of
-            // about 5° at σ = 1.5 mm for l = l1), so the knee comes to rest without a kink;
-            // l = `span_max` (l1, or the shorter locked leg at speed).
+            // The knee straightens smoothly: the leg's length is the soft reach
+            // (`ik::soft_reach`) of the hip–flat-ankle distance, saturating at l − σ (a knee
+            // flexion of about 5° at σ = 1.5 mm for l = l1), so the knee comes to rest without a
+            // kink; l = `span_max` (l1, or the shorter locked leg at speed).
             let d_flat = reach(self, 0.0) + l1;
             let sigma = self.knee_soft;
             let lm = self.span_max.min(l1);
-            let a0 = lm - 2.0 * sigma;
-            let d_t = if d_flat <= a0 {
-                d_flat
-            } else if d_flat >= lm {
-                lm - sigma
-            } else {
-                d_flat - (d_flat - a0).powi(2) / (4.0 * sigma)
-            };
+            let d_t = crate::generator::ik::soft_reach(d_flat, lm, sigma);
             // Only where a landing narrowed the knee's soft margin (see `KNEE_EASE_SOFT`,
             // `KNEE_ROCKER_EASE`) or the straight leg landed the foot (`KNEE_LAND_EASE`).
             let d_t = if self.knee_soft < KNEE_EASE_SOFT
@@ -1274,94 +992,6 @@ mod tests {
             );
             assert!(start_rate.abs() < 0.05, "{start_rate}");
         }
-    }
-
-    #[test]
-    fn smoothed_roll_is_never_below_the_rule_and_keeps_its_ends() {
-        // Flat until 0.1 s, a 0.02 rad rise in 8 ms (the rule's heel-off kick), then a creep.
-        let times: Vec<f64> = (0..=200).map(|i| 0.002 * i as f64).collect();
-        let rule: Vec<f64> = times
-            .iter()
-            .map(|&t| {
-                if t < 0.1 {
-                    0.0
-                } else if t < 0.108 {
-                    0.02 * (t - 0.1) / 0.008
-                } else {
-                    0.02 + 0.1 * (t - 0.108)
-                }
-            })
-            .collect();
-        let mut s = rule.clone();
-        smooth_roll(&times, &mut s, 0, false, 0.02);
-        assert_eq!(s[0], rule[0]);
-        assert_eq!(s[200], rule[200]);
-        assert_eq!(s[199], rule[199]);
-        for i in 0..=200 {
-            assert!(s[i] >= rule[i] - 1e-12, "below the rule at {i}");
-            if i > 0 {
-                assert!(s[i] >= s[i - 1] - 1e-9, "decreasing at {i}");
-            }
-        }
-        let max_inc = |v: &[f64]| v.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
-        assert!(
-            max_inc(&s) < 0.25 * max_inc(&rule),
-            "{} vs {}",
-            max_inc(&s),
-            max_inc(&rule)
-        );
-    }
-
-    /// The continuity check's ratio ([`crate::generator::checks::continuity`]: each step
-    /// against the median of the 3 on each side, floored) of a series sampled every 10 ms.
-    fn worst_step_ratio(v: &[f64], floor: f64) -> f64 {
-        let steps: Vec<f64> = v.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
-        crate::generator::checks::step_ratios(&steps, 3, floor)
-            .into_iter()
-            .flatten()
-            .fold(0.0, f64::max)
-    }
-
-    #[test]
-    fn roll_after_a_flat_landing_starts_at_rest_and_spreads_the_heel_off_kick() {
-        // What the rule does at 3 km/h: the foot lands flat at rest at 0.11 s (rocker roll
-        // < 0 before), the telescopic leg reaches the soft band 20 ms later and locks 15 ms
-        // after that: the heel-off roll rises 0.0146 rad in 15 ms, then creeps at 7.5 mrad/s.
-        let times: Vec<f64> = (0..=300).map(|i| 0.002 * i as f64).collect();
-        let rule: Vec<f64> = times
-            .iter()
-            .map(|&t| {
-                if t < 0.11 {
-                    -0.05 * (0.11 - t) * (0.11 - t) / 0.0121
-                } else if t < 0.131 {
-                    0.0
-                } else if t < 0.146 {
-                    0.0146 * ((t - 0.131) / 0.015).powi(2)
-                } else {
-                    0.0146 + 0.0075 * (t - 0.146)
-                }
-            })
-            .collect();
-        let from = rule.iter().position(|&r| r >= 0.0).unwrap();
-        let mut s = rule.clone();
-        smooth_roll(&times, &mut s, from, true, 0.02);
-        assert_eq!(
-            &s[..=from],
-            &rule[..=from],
-            "the heel rocker is not touched"
-        );
-        assert_eq!(s[from + 1], s[from], "lands at rest");
-        for i in from..=300 {
-            assert!(s[i] >= rule[i] - 1e-12, "below the rule at {i}");
-        }
-        // Sampled at 100 frames/s, the heel-off roll passes the continuity check (k = 5, floor
-        // 1 mrad scaled to the heel: a 0.2 m lever, 0.1 mm floor), which the rule fails.
-        let frames = |v: &[f64]| v.iter().step_by(5).copied().collect::<Vec<f64>>();
-        let floor = 1e-4 / 0.2;
-        let before = worst_step_ratio(&frames(&rule[from..]), floor);
-        let after = worst_step_ratio(&frames(&s[from..]), floor);
-        assert!(before > 5.0, "the rule's kick: {before}");
-        assert!(after < 3.0, "smoothed: {after}");
     }
 
     #[test]
