@@ -298,8 +298,7 @@ impl VirtualLeg {
         let reached = d <= l3 + l4 && d >= (l3 - l4).abs();
         let dc = d.clamp((l3 - l4).abs() + 1e-12, l3 + l4);
         // In the leg plane: hip at (dx, dy) from the ankle; the knee bends forward.
-        let cos_k = ((l3 * l3 + l4 * l4 - dc * dc) / (2.0 * l3 * l4)).clamp(-1.0, 1.0);
-        let knee = std::f64::consts::PI - cos_k.acos();
+        let knee = knee_for(l3, l4, dc);
         // Angle at the ankle between the ankle–hip line and the shank.
         let cos_a = ((l4 * l4 + dc * dc - l3 * l3) / (2.0 * l4 * dc)).clamp(-1.0, 1.0);
         let line = dx.atan2(dy_in_plane); // forward tilt of the ankle–hip line
