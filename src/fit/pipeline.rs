@@ -42,14 +42,13 @@
 //!    with level 0), the published coefficients' r² and rmse on the same rows, t-tests against
 //!    the published values (where the paper gives one), optional Huber IRLS and weighted fits and
 //!    a seeded bootstrap by subject.
-use super::constrained::{column_bounds, ActiveBound, BoxStats, ColumnBounds};
-use super::design::{augment, Covariance, DesignFit, Layout, SubjectSums, Totals, MAX_BASIS};
+use super::constrained::{column_bounds, ActiveBound, BoxStats};
+use super::design::{augment, Covariance, DesignFit, Layout, Totals, MAX_BASIS};
 use super::inference::{SeMethod, CR2_RECOMMENDED_BELOW};
-use super::ols::{huber_irls, LinearProblem};
 use super::prec::ILL_CONDITIONED;
 use super::record::{
-    BootstrapRecord, CoefficientRecord, DataFile, DataRecord, DerivedRecord, FitRecord,
-    InferenceRecord, PublishedFit, RangeRecord, RejectionRecord, RobustRecord, TTestRecord,
+    BootstrapRecord, CoefficientRecord, DataRecord, DerivedRecord, FitRecord, PublishedFit,
+    RangeRecord, TTestRecord,
 };
 use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
@@ -57,17 +56,27 @@ use super::stats::{
 use super::FitError;
 use crate::fit::forms::Fitting;
 use crate::ingest::trials::TrialsTable;
-use crate::relations::{Observation, ParamKind, Relation};
+use crate::relations::{ParamKind, Relation};
 use profile::{
     confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, Profiler,
     SortedRows, Source, Subset,
 };
 
+mod band;
+mod describe;
+mod prepare;
 mod profile;
-use crate::units::parse_header;
+mod robust;
+mod sums;
+use band::{step, Band};
+use describe::{design_effect, inference_record};
 use nalgebra::{DMatrix, DVector};
+use prepare::weight_column;
+pub use prepare::{is_trials_table, load_tables, prepare, Prepared, RawStepReader};
 pub use profile::{DISCRETE_MAX_EVALS, PROFILE_GRID};
+use robust::robust_refit;
 use std::collections::BTreeMap;
+use sums::{all_subject_sums, loso_from_subject_sums, solve_totals};
 
 /// Huber tuning constant (95 % efficiency under normal errors).
 pub const HUBER_K: f64 = 1.345;
@@ -77,9 +86,6 @@ pub const HUBER_MAX_ITER: usize = 100;
 pub const BREAKPOINT_TEST_ALPHA: f64 = 0.05;
 /// Confidence level of every interval gaitfit reports.
 pub const CONFIDENCE: f64 = 0.95;
-/// Rows listed per rejection reason.
-const MAX_EXAMPLES: usize = 10;
-
 /// Settings of a fit (validated once, by [`FitOptions::validate`]).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FitOptions {
@@ -135,259 +141,6 @@ impl FitOptions {
     }
 }
 
-fn weight_column<'a>(t: &'a TrialsTable, name: &str) -> Option<&'a [f64]> {
-    if let Ok(Some(c)) = parse_header(name) {
-        if let Some(col) = &t.columns[c.quantity as usize] {
-            return Some(col);
-        }
-    }
-    t.extra
-        .iter()
-        .find(|(n, _)| n.eq_ignore_ascii_case(name))
-        .map(|(_, v)| v.as_slice())
-}
-
-/// The rows a relation can use, reduced to observations.
-#[derive(Debug, Clone, PartialEq, Default)]
-pub struct Prepared {
-    /// Observations (papers' units).
-    pub obs: Vec<Observation>,
-    /// Per observation: index into `subjects`.
-    pub subject: Vec<usize>,
-    /// Subjects among the used rows, in order of first appearance.
-    pub subjects: Vec<String>,
-    /// Per observation: index into `files`, the data set it came from (reports colour
-    /// residuals by subject and data set, so treadmill and overground rows are not pooled).
-    pub file: Vec<u32>,
-    /// Per observation: weight (all 1 without `--weights`).
-    pub weights: Vec<f64>,
-    /// Rejections by reason.
-    pub rejected: Vec<RejectionRecord>,
-    /// Rows rejected.
-    pub n_rejected: usize,
-    /// Rows of the other gait.
-    pub n_other_gait: usize,
-    /// The files.
-    pub files: Vec<DataFile>,
-}
-
-/// Reduces the tables' rows to the observations `rel` uses, recording every rejection.
-pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>) -> Prepared {
-    let mut p = Prepared::default();
-    let mut reasons: BTreeMap<String, (usize, Vec<String>)> = BTreeMap::new();
-    let mut subj_index: BTreeMap<String, usize> = BTreeMap::new();
-    let mut reject = |reason: String, file: &str, row: usize, p: &mut Prepared| {
-        let e = reasons.entry(reason).or_insert((0, Vec::new()));
-        e.0 += 1;
-        if e.1.len() < MAX_EXAMPLES {
-            e.1.push(format!("{file}: row {row}"));
-        }
-        p.n_rejected += 1;
-    };
-    p.obs.reserve(tables.iter().map(|t| t.len()).sum());
-    for t in tables {
-        let file = t.path.display().to_string();
-        let file_index = p.files.len() as u32;
-        p.files.push(DataFile {
-            path: file.clone(),
-            sha256: t.sha256.clone(),
-            rows: t.len(),
-        });
-        let flags: BTreeMap<usize, &str> =
-            t.flagged.iter().map(|(r, s)| (*r, s.as_str())).collect();
-        let wcol = weights.and_then(|w| weight_column(t, w));
-        let mut subj_of_table: Vec<Option<usize>> = vec![None; t.subjects.len()];
-        for i in 0..t.len() {
-            match t.gait[i] {
-                Some(g) if g == rel.gait() => {}
-                Some(_) => {
-                    p.n_other_gait += 1;
-                    continue;
-                }
-                None => {
-                    reject("gait missing".into(), &file, i + 1, &mut p);
-                    continue;
-                }
-            }
-            if t.is_flagged[i] {
-                let why = flags
-                    .get(&(i + 1))
-                    .copied()
-                    .unwrap_or("inconsistent values");
-                let kind = if why.contains("speed") {
-                    "flagged: speed, step length and step frequency disagree by more than 2 %"
-                } else {
-                    "flagged: inconsistent double-support values"
-                };
-                reject(kind.into(), &file, i + 1, &mut p);
-                continue;
-            }
-            let w = match wcol {
-                Some(c) => {
-                    let w = c[i];
-                    if !(w.is_finite() && w > 0.0) {
-                        reject(
-                            "weight missing or not positive".into(),
-                            &file,
-                            i + 1,
-                            &mut p,
-                        );
-                        continue;
-                    }
-                    w
-                }
-                None => 1.0,
-            };
-            // A row gives one observation per output; it is rejected when none is usable.
-            let row = t.values(i);
-            let mut first_err = None;
-            let mut used = false;
-            for out in 0..rel.outputs() {
-                match rel.observe_output(&row, out) {
-                    Ok(o) => {
-                        // The table's subject id → ours, looked up by name once per id (not
-                        // once per row: a string map per row was a fifth of this function).
-                        let ts = t.subject[i] as usize;
-                        let k = match subj_of_table.get(ts).copied().flatten() {
-                            Some(k) => k,
-                            None => {
-                                let name = t.subject_name(i);
-                                let k = match subj_index.get(name) {
-                                    Some(&k) => k,
-                                    None => {
-                                        let k = p.subjects.len();
-                                        p.subjects.push(name.to_string());
-                                        subj_index.insert(name.to_string(), k);
-                                        k
-                                    }
-                                };
-                                if let Some(slot) = subj_of_table.get_mut(ts) {
-                                    *slot = Some(k);
-                                }
-                                k
-                            }
-                        };
-                        p.obs.push(o);
-                        p.subject.push(k);
-                        p.file.push(file_index);
-                        p.weights.push(w);
-                        used = true;
-                    }
-                    Err(r) => {
-                        first_err.get_or_insert(r);
-                    }
-                }
-            }
-            if let (false, Some(r)) = (used, first_err) {
-                reject(r.to_string(), &file, i + 1, &mut p);
-            }
-        }
-    }
-    p.rejected = reasons
-        .into_iter()
-        .map(|(reason, (count, examples))| RejectionRecord {
-            reason,
-            count,
-            examples,
-        })
-        .collect();
-    p
-}
-
-/// Leave-one-subject-out for a fit with only linear coefficients to refit: every subject's
-/// sums ([`SubjectSums`]) from one pass, each fold solved from the sums of the others (prefix +
-/// suffix over subjects: no subtraction, no pass per fold). Per subject, in subject order: the
-/// squared prediction errors of its rows (level 0), or `None` when the fold is singular.
-fn loso_from_subject_sums(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p: &[f64],
-    prep: &Prepared,
-    bounds: Option<(&ColumnBounds, &BoxStats)>,
-) -> Vec<Option<Vec<f64>>> {
-    let n_subj = prep.subjects.len();
-    let m = lay.m();
-    let nes = super::design::subject_normal_equations(rel, lay, p, prep, None, None, n_subj);
-    let Some(sums) = nes
-        .iter()
-        .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
-        .collect::<Option<Vec<_>>>()
-    else {
-        return vec![None; n_subj];
-    };
-    drop(nes);
-    let mut prefix = Vec::with_capacity(n_subj + 1);
-    prefix.push(Totals::zeros(m));
-    for s in &sums {
-        let mut t = prefix[prefix.len() - 1].clone();
-        t.add(s, 1.0);
-        prefix.push(t);
-    }
-    let mut suffix = vec![Totals::zeros(m); n_subj + 1];
-    for s in (0..n_subj).rev() {
-        let mut t = suffix[s + 1].clone();
-        t.add(&sums[s], 1.0);
-        suffix[s] = t;
-    }
-    let mut rows_of = vec![Vec::new(); n_subj];
-    for (i, &s) in prep.subject.iter().enumerate() {
-        rows_of[s].push(i);
-    }
-    (0..n_subj)
-        .map(|s| {
-            let mut t = prefix[s].clone();
-            t.add_totals(&suffix[s + 1]);
-            let coef = solve_totals(&t, lay, bounds)?;
-            let q = lay.params(rel, p, &coef);
-            Some(
-                rows_of[s]
-                    .iter()
-                    .map(|&i| {
-                        let o = &prep.obs[i];
-                        (o.y - rel.predict_with(&q, 0.0, &o.x)).powi(2)
-                    })
-                    .collect(),
-            )
-        })
-        .collect()
-}
-
-/// The basis coefficients of some subjects' sums, by the bounded solver when there are bounds
-/// (recording the solve), else by the normal equations.
-fn solve_totals(
-    t: &Totals,
-    lay: &Layout,
-    bounds: Option<(&ColumnBounds, &BoxStats)>,
-) -> Option<DVector<f64>> {
-    match bounds {
-        None => t.solve(lay).map(|r| r.0),
-        Some((cb, stats)) => match t.solve_box(lay, &cb.lo, &cb.hi) {
-            Some((coef, _, sol)) => {
-                stats.record(&sol);
-                Some(coef)
-            }
-            None => {
-                stats.record_failure();
-                None
-            }
-        },
-    }
-}
-
-/// Every subject's [`SubjectSums`] at `p`, or `None` when a subject's own column is all zeros.
-fn all_subject_sums(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p: &[f64],
-    prep: &Prepared,
-) -> Option<Vec<SubjectSums>> {
-    let n_subj = prep.subjects.len();
-    super::design::subject_normal_equations(rel, lay, p, prep, None, None, n_subj)
-        .iter()
-        .map(|ne| SubjectSums::absorb(ne, lay.subj_col))
-        .collect()
-}
-
 /// Everything a fit produced: the record plus what plots need.
 #[derive(Debug)]
 pub struct FitOutcome {
@@ -408,122 +161,8 @@ pub struct FitOutcome {
     band: Band,
 }
 
-/// What the confidence band of the mean prediction needs.
-#[derive(Debug, Clone)]
-struct Band {
-    lay: Layout,
-    coef: DVector<f64>,
-    cov: Covariance,
-    /// Free breakpoints in θ (parameter index), when the covariance has them free.
-    bps: Vec<usize>,
-}
-
-impl Band {
-    /// The mean prediction at `x` for parameters `p` and basis coefficients `coef`.
-    fn mean(&self, rel: &dyn Relation, p: &[f64], coef: &DVector<f64>, x: &[f64]) -> f64 {
-        let mut phi = [0.0; MAX_BASIS];
-        let off = rel.basis(p, &self.lay.free, x, &mut phi[..self.lay.nb]);
-        off + (0..self.lay.nb).map(|j| phi[j] * coef[j]).sum::<f64>()
-    }
-    /// The gradient of the mean prediction over θ.
-    fn ell(&self, rel: &dyn Relation, p: &[f64], x: &[f64]) -> DVector<f64> {
-        let lay = &self.lay;
-        let mut phi = [0.0; MAX_BASIS];
-        rel.basis(p, &lay.free, x, &mut phi[..lay.nb]);
-        let k = self.cov.k;
-        let dim = k + usize::from(self.cov.has_fe);
-        let mut ell = DVector::zeros(dim);
-        let mut g = 0;
-        for (j, &v) in phi[..lay.nb].iter().enumerate() {
-            if Some(j) == lay.subj_col {
-                ell[k] = v;
-            } else {
-                ell[g] = v;
-                g += 1;
-            }
-        }
-        for (b, &i) in self.bps.iter().enumerate() {
-            let h = step(p[i]);
-            let (mut up, mut dn) = (p.to_vec(), p.to_vec());
-            up[i] += h;
-            dn[i] -= h;
-            ell[g + b] = (self.mean(rel, &up, &self.coef, x) - self.mean(rel, &dn, &self.coef, x))
-                / (2.0 * h);
-        }
-        ell
-    }
-}
-
-/// Step of the central differences with respect to a breakpoint at `t`.
-fn step(t: f64) -> f64 {
-    1e-6 * t.abs().max(1.0)
-}
-
-impl FitOutcome {
-    /// The refit prediction for an average subject at `x` with its 95 % confidence band
-    /// (under the fit's inference method): `(mean, lo, hi)`.
-    pub fn band(&self, x: &[f64]) -> (f64, f64, f64) {
-        let rel = self.refit.as_ref();
-        let b = &self.band;
-        let m = b.mean(rel, &self.values, &b.coef, x);
-        let ell = b.ell(rel, &self.values, x);
-        let var = ell.dot(&(&b.cov.v * &ell)).max(0.0);
-        let q = t_quantile(0.5 + 0.5 * CONFIDENCE, b.cov.df(&ell));
-        (m, m - q * var.sqrt(), m + q * var.sqrt())
-    }
-}
-
-/// Rao & Scott's mean design effect `tr(V_iid⁻¹ V)/p` (NaN when `V_iid` is singular).
-fn design_effect(v_iid: &DMatrix<f64>, v: &DMatrix<f64>) -> f64 {
-    let p = v.nrows();
-    if p == 0 {
-        return 1.0;
-    }
-    match v_iid.clone().cholesky() {
-        Some(c) => c.solve(v).trace() / p as f64,
-        None => f64::NAN,
-    }
-}
-
 fn opt(v: f64) -> Option<f64> {
     v.is_finite().then_some(v)
-}
-
-/// The inference record's text for a method on `g` subjects.
-fn inference_record(
-    method: SeMethod,
-    g: usize,
-    df_iid: f64,
-    breakpoints: String,
-) -> InferenceRecord {
-    let recommendation = if g < 2 {
-        "one subject: rows can only be treated as independent (iid); the standard errors \
-         ignore that they are repeated measures of one person"
-            .to_string()
-    } else if g < CR2_RECOMMENDED_BELOW {
-        format!(
-            "{g} subjects (< {CR2_RECOMMENDED_BELOW}): CR2 with Bell–McCaffrey degrees of freedom \
-             (--se cr2) is recommended; CR1 with G − 1 degrees of freedom over-rejects with few \
-             or unbalanced clusters"
-        )
-    } else {
-        format!(
-            "{g} subjects: CR1 (the default) is adequate; CR2 (--se cr2) is the cautious choice \
-             when cluster sizes are very unbalanced"
-        )
-    };
-    InferenceRecord {
-        method: method.label().to_string(),
-        description: method.describe().to_string(),
-        clusters: g,
-        df: match method {
-            SeMethod::Iid => Some(df_iid),
-            SeMethod::Cluster => Some(g as f64 - 1.0),
-            SeMethod::Cr2 => None,
-        },
-        breakpoints,
-        recommendation,
-    }
 }
 
 /// Fits `rel` (its current coefficients are the published reference and the values of held
@@ -1478,152 +1117,6 @@ pub fn fit_relation(
         values,
         band,
     })
-}
-
-/// The Huber refit of the linear coefficients at the breakpoint estimates (dense design: the
-/// per-subject column, if any, as one column per subject).
-#[allow(clippy::too_many_arguments)]
-fn robust_refit(
-    rel: &dyn Relation,
-    lay: &Layout,
-    p: &[f64],
-    prep: &Prepared,
-    free: &[bool],
-    held_reason: &[Option<String>],
-    published: &[f64],
-    weighted: bool,
-) -> Result<RobustRecord, FitError> {
-    let n = prep.obs.len();
-    let n_subj = prep.subjects.len();
-    let m = lay.m();
-    let nfe = if lay.subj_col.is_some() { n_subj } else { 0 };
-    let nc = m + nfe;
-    let mut x = DMatrix::<f64>::zeros(n, nc);
-    let mut y = DVector::<f64>::zeros(n);
-    let mut g = [0.0; MAX_BASIS];
-    for i in 0..n {
-        let (off, z) = lay.row(rel, p, &prep.obs[i].x, &mut g[..m]);
-        for j in 0..m {
-            x[(i, j)] = g[j];
-        }
-        if nfe > 0 {
-            x[(i, m + prep.subject[i])] = z;
-        }
-        y[i] = prep.obs[i].y - off;
-    }
-    let w = DVector::from_vec(prep.weights.clone());
-    let id = rel.id();
-    let mut problem = LinearProblem::new(&x, &y).named(id);
-    if weighted {
-        problem = problem.with_weights(&w);
-    }
-    let h = huber_irls(&problem, HUBER_K, HUBER_MAX_ITER)?;
-    // Design coefficients → basis coefficients (mean slope) → raw linear parameters.
-    let mut e = DMatrix::zeros(lay.nb, nc);
-    let mut gi = 0;
-    for j in 0..lay.nb {
-        if Some(j) == lay.subj_col {
-            for s in 0..n_subj {
-                e[(j, m + s)] = 1.0 / n_subj as f64;
-            }
-        } else {
-            e[(j, gi)] = 1.0;
-            gi += 1;
-        }
-    }
-    let lm = rel.basis_to_params(p, free);
-    let gmap = &lm.map * e;
-    let rout = &gmap * &h.fit.coef + &lm.shift;
-    // Huber's H1 sandwich (statsmodels RLM's default), not the last weighted fit's covariance.
-    let rcov = &gmap * &h.cov * gmap.transpose();
-    let df = h.fit.df_resid as f64;
-    let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
-    let mut rc = Vec::new();
-    let mut j = 0;
-    for (i, s) in rel.parameters().iter().enumerate() {
-        if s.kind != ParamKind::Linear {
-            continue;
-        }
-        let se = free[i].then(|| rcov[(j, j)].max(0.0).sqrt());
-        rc.push(CoefficientRecord {
-            name: s.name.to_string(),
-            unit: s.unit.to_string(),
-            value: rout[j],
-            std_error: se,
-            ci95: se.map_or([None, None], |se| {
-                [opt(rout[j] - tq * se), opt(rout[j] + tq * se)]
-            }),
-            published: s.cited.then_some(published[i]),
-            t_test: None,
-            std_error_conditional: None,
-            inference: None,
-            ci95_bootstrap: None,
-            se_bootstrap: None,
-            held: if free[i] {
-                None
-            } else {
-                held_reason[i].clone()
-            },
-            flag: None,
-        });
-        j += 1;
-    }
-    Ok(RobustRecord {
-        k: h.k,
-        scale: h.scale,
-        iterations: h.iterations,
-        converged: h.converged,
-        rows_downweighted: h.robust_weights.iter().filter(|&&u| u < 1.0).count(),
-        cov: Some(format!(
-            "Huber's sandwich with his small-sample correction (H1, as statsmodels RLM's \
-             default): κ²·[Σψ²/(n − p)]·s²/[Σψ'/n]²·(XᵀWX)⁻¹ on the design at the breakpoint \
-             estimates{}; rows treated as independent; intervals t with {df} df",
-            if nfe > 0 {
-                " with one slope column per subject (the global slope is their mean)"
-            } else {
-                ""
-            }
-        )),
-        coefficients: rc,
-    })
-}
-
-/// Reads raw measured files (C3D, TRC + forces, treadmill GRF, …) into per-step rows: the hook
-/// through which the events layer feeds `gaitfit fit` (pass it to [`load_tables`]).
-pub type RawStepReader = fn(&std::path::Path) -> crate::Result<Vec<crate::ingest::trials::StepRow>>;
-
-/// Whether `path` names a trials table (`.csv`) rather than a raw measured file.
-pub fn is_trials_table(path: &std::path::Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"))
-}
-
-/// Loads trials tables (`.csv`) and, through `raw`, raw measured files.
-pub fn load_tables(
-    paths: &[std::path::PathBuf],
-    raw: Option<RawStepReader>,
-) -> crate::Result<Vec<TrialsTable>> {
-    let mut out = Vec::with_capacity(paths.len());
-    for p in paths {
-        if is_trials_table(p) {
-            out.push(crate::ingest::trials::read_trials(p)?);
-        } else if let Some(raw) = raw {
-            let rows = raw(p)?;
-            let mut t = TrialsTable::from_step_rows(p, &rows);
-            if let Ok(bytes) = std::fs::read(p) {
-                t.sha256 = crate::ingest::trials::sha256_hex(&bytes);
-            }
-            out.push(t);
-        } else {
-            return Err(crate::ingest::IngestError::malformed(
-                p,
-                "not a trials table (.csv); raw measured files need the events layer: \
-                 derive per-step rows with `gaitfit events` and pass the resulting CSV",
-            )
-            .into());
-        }
-    }
-    Ok(out)
 }
 
 /// The outcome of fitting several relations.
