@@ -33,12 +33,13 @@ reports/ (per relation: data with refit curve, 95 % band and published curve; re
 fitted; normal Q–Q; summary.md). Files are replaced atomically; a relation that fails to fit \
 leaves its existing fits/ files untouched and makes the command exit 1.\n\n\
 Inference: gait rows are repeated measures (many steps per subject), so with two or more \
-subjects standard errors are clustered by subject: CR1 exactly as statsmodels \
-cov_type='cluster' (small-sample factor G/(G−1)·(n−1)/(n−K)), t-tests and intervals with G − 1 \
-degrees of freedom. With fewer than 20 subjects `--se cr2` is recommended: CR1 over-rejects \
-with few or unbalanced clusters, while CR2 (Bell & McCaffrey 2002) with Satterthwaite degrees \
-of freedom keeps close to the nominal level (Imbens & Kolesár 2016; Pustejovsky & Tipton 2018). \
-Each fit record states its method. Breakpoints get the F-based profile confidence set over every \
+subjects standard errors are clustered by subject. From 20 subjects on: CR1 exactly as \
+statsmodels cov_type='cluster' (small-sample factor G/(G−1)·(n−1)/(n−K)), t-tests and intervals \
+with G − 1 degrees of freedom. With fewer than 20 subjects the default is CR2 (Bell & McCaffrey \
+2002) with Satterthwaite degrees of freedom, which keeps close to the nominal level where CR1 \
+under-covers with few or unbalanced subjects (Imbens & Kolesár 2016; Pustejovsky & Tipton \
+2018; measured on the bundled walking data by tools/reference/coverage.py). Each fit record \
+states its method. Breakpoints get the F-based profile confidence set over every \
 admissible value (its pieces and hull); only a regular profile gives them a standard error.\n\n\
 Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf, kb-mu \
 (Ko & Badler 1993 eqs. 21–24: one observation per μ-function and row, α bounds enforced; r² is \
@@ -78,9 +79,9 @@ pub struct Args {
     #[arg(long, value_name = "S", default_value_t = 1)]
     pub seed: u64,
     /// Standard errors, t-tests and intervals: `cluster` (CR1 by subject, as statsmodels
-    /// cov_type='cluster', t with G − 1 df; the default with two or more subjects), `cr2`
-    /// (Bell–McCaffrey CR2 by subject with Satterthwaite df; recommended below 20 subjects,
-    /// where CR1 over-rejects), or `iid` (rows independent; the default with one subject).
+    /// cov_type='cluster', t with G − 1 df; the default from 20 subjects on), `cr2`
+    /// (Bell–McCaffrey CR2 by subject with Satterthwaite df; the default with 2–19 subjects,
+    /// where CR1 under-covers), or `iid` (rows independent; the default with one subject).
     #[arg(long, value_enum, value_name = "METHOD")]
     pub se: Option<SeArg>,
     /// Do not write reports/ (plots and summary).
@@ -229,8 +230,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         .collect();
     if !few.is_empty() {
         println!(
-            "note: fewer than {CR2_RECOMMENDED_BELOW} subjects in {}: CR1 over-rejects with few \
-             clusters; --se cr2 is recommended",
+            "note: fewer than {CR2_RECOMMENDED_BELOW} subjects in {}: CR1 (asked for) \
+             under-covers with few clusters; CR2 (the default there) is recommended",
             few.join(", ")
         );
     }

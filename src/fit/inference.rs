@@ -17,7 +17,7 @@
 //!   `Ω = σ²I`, Imbens & Kolesár eq. 10). CR2 is unbiased under that working model and its
 //!   degrees of freedom follow the clusters' leverage, so with few or unbalanced subjects it
 //!   keeps the nominal coverage where CR1 with `G − 1` does not (Imbens & Kolesár 2016 §3;
-//!   Pustejovsky & Tipton 2018). Below [`CR2_RECOMMENDED_BELOW`] subjects gaitfit recommends it.
+//!   Pustejovsky & Tipton 2018). Below [`CR2_RECOMMENDED_BELOW`] subjects it is gaitfit's default.
 //!
 //! # Never forming `H_gg`
 //! `H_gg = X_g M X_gᵀ` has rank ≤ p, so any function of it is one of a p × p matrix: with
@@ -27,7 +27,7 @@
 //! sums need `X_gᵀ A_g X_g` and `X_gᵀ A_g² X_g` the same way: every cluster costs O(p³).
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-/// Below this many subjects `gaitfit` recommends `--se cr2` (and says so in `--help` and in
+/// Below this many subjects `gaitfit` uses CR2 by default (and says so in `--help` and in
 /// the report): CR1 with `G − 1` degrees of freedom over-rejects with fewer than about 20–40
 /// clusters, more so when cluster sizes are unbalanced (Cameron & Miller 2015, §VI; Imbens &
 /// Kolesár 2016, Table 1), while CR2 with Bell–McCaffrey degrees of freedom stays close to

@@ -97,16 +97,23 @@ pub struct FitOptions {
     pub bootstrap: usize,
     /// Seed of the bootstrap.
     pub seed: u64,
-    /// Standard errors: `None` = clustered by subject (CR1) with two or more subjects, else iid.
+    /// Standard errors: `None` = clustered by subject with two or more subjects — CR2 with
+    /// Bell–McCaffrey degrees of freedom below [`CR2_RECOMMENDED_BELOW`] subjects, CR1 from
+    /// there on — else iid.
     pub se: Option<SeMethod>,
 }
 
 impl FitOptions {
-    /// The standard-error method for rows from `n_subj` subjects: the one asked for, else CR1
-    /// with two or more subjects and iid with one. Clustered methods need two subjects.
+    /// The standard-error method for rows from `n_subj` subjects: the one asked for, else
+    /// clustered by subject with two or more subjects — CR2 with Bell–McCaffrey degrees of
+    /// freedom below [`CR2_RECOMMENDED_BELOW`] subjects (CR1 with G − 1 degrees of freedom
+    /// under-covers with few or unbalanced subjects: Cameron & Miller 2015 §VI, Imbens & Kolesár
+    /// 2016; measured on the bundled walking designs by `tools/reference/coverage.py`), CR1
+    /// from there on — and iid with one. Clustered methods need two subjects.
     pub fn se_method(&self, relation: &str, n_subj: usize) -> Result<SeMethod, FitError> {
         match self.se {
-            None if n_subj >= 2 => Ok(SeMethod::Cluster),
+            None if n_subj >= CR2_RECOMMENDED_BELOW => Ok(SeMethod::Cluster),
+            None if n_subj >= 2 => Ok(SeMethod::Cr2),
             None => Ok(SeMethod::Iid),
             Some(SeMethod::Iid) => Ok(SeMethod::Iid),
             Some(m) if n_subj >= 2 => Ok(m),

@@ -38,25 +38,37 @@ fn inference_paragraph(records: &[FitRecord]) -> String {
     format!(
         "**How the uncertainty was computed.** Gait rows are repeated measures: each subject \
          contributes many steps, and steps of one person are not independent, so every standard \
-         error here is clustered by subject ({}): the sandwich estimator with one score per \
-         subject, CR1 as statsmodels `cov_type='cluster'` computes it (small-sample factor \
-         G/(G−1)·(n−1)/(n−K)), with t-tests and 95 % intervals on G − 1 degrees of freedom, \
-         G the number of subjects — not on the number of rows. With fewer than \
-         {} subjects CR1 still over-rejects, so `--se cr2` (Bell–McCaffrey bias-reduced \
-         sandwich with Satterthwaite degrees of freedom) is recommended there; each fit states \
-         its method and the recommendation for its subjects. Per-subject levels of run-sl-v \
-         are informed by one subject each and get only a within-subject (iid) standard error; \
-         the global slope is the mean of the subjects' slopes and its clustered standard error \
-         includes their spread. A breakpoint's 95 % set is every value whose profile residual \
-         sum of squares passes the F-test against the minimum, searched over all admissible \
-         partitions of the rows (or a fine grid for a continuous breakpoint) and reported as its \
-         pieces and their hull; a breakpoint whose model jumps, or whose profile is irregular \
-         (several pieces or minima), has no standard error or t-test, and the linear \
-         coefficients' standard errors are then conditional on it — the subject bootstrap{} \
-         refits the breakpoints in every replicate and shows what that conditioning leaves out. \
-         Where a breakpoint's profile is regular, the linear standard errors are those with the \
-         breakpoint free (Gauss–Newton), with the conditional ones beside them. Coefficients \
-         the paper does not give (Ko–Badler's α) have no published value and no t-test.",
+         error here is clustered by subject ({}), with t-tests and 95 % intervals whose degrees \
+         of freedom follow the number of subjects G, not the number of rows. From {} subjects \
+         on the method is CR1 as statsmodels `cov_type='cluster'` computes it (small-sample \
+         factor G/(G−1)·(n−1)/(n−K), G − 1 degrees of freedom). Below that it is CR2, Bell & \
+         McCaffrey's bias-reduced sandwich, with their Satterthwaite degrees of freedom (Imbens \
+         & Kolesár 2016): with few subjects, or one subject holding most rows, CR1 is biased \
+         down and its t-intervals under-cover (Cameron & Miller 2015, §VI), while CR2's degrees \
+         of freedom shrink with the subjects' leverage (see each coefficient's t-test) and its \
+         intervals widen accordingly. The subject bootstrap{} is shown beside every \
+         analytic interval, but with few and unequal subjects it is not a reference either: a \
+         Monte Carlo on the bundled walking designs (9–10 subjects, one with 252 of 295 rows; \
+         tools/reference/coverage.py, numbers in tools/reference/coverage.json) finds that for \
+         walk-sl-sf (one coefficient, no intercept) CR1 and the bootstrap intervals fall far \
+         below their nominal 95 % coverage while CR2 with Bell–McCaffrey degrees of freedom \
+         comes close to it, and that for walk-tds-sf all three reach it, CR2 conservatively; \
+         so where they disagree here the CR2 interval is the one that does not overstate the \
+         precision of the linear coefficients. Per-subject levels of run-sl-v are informed by \
+         one subject each and get only a within-subject (iid) standard error; the global slope is the mean of the \
+         subjects' slopes and its clustered standard error includes their spread. A \
+         breakpoint's 95 % set is every value whose profile residual sum of squares passes the \
+         F-test against the minimum (the likelihood ratio divided by the clustering's design \
+         effect), searched over all admissible partitions of the rows (or a fine grid for a \
+         continuous breakpoint) and reported as its pieces and their hull; a breakpoint whose \
+         model jumps, or whose profile is irregular (several pieces or minima), has no standard \
+         error or t-test, and the linear coefficients' standard errors are then conditional on \
+         it — the bootstrap refits the breakpoints in every replicate and shows what that \
+         conditioning leaves out (for run-tflight-sf's polynomial coefficients, which swing \
+         with k1, its intervals are the ones to read). Where a breakpoint's profile is regular, \
+         the linear standard errors are those with the breakpoint free (Gauss–Newton), with the \
+         conditional ones beside them. Coefficients the paper does not give (Ko–Badler's α) \
+         have no published value and no t-test.",
         methods.join(", "),
         crate::fit::inference::CR2_RECOMMENDED_BELOW,
         boot.map_or(String::new(), |b| format!(

@@ -31,13 +31,15 @@ pub(super) fn inference_record(
     } else if g < CR2_RECOMMENDED_BELOW {
         format!(
             "{g} subjects (< {CR2_RECOMMENDED_BELOW}): CR2 with Bell–McCaffrey degrees of freedom \
-             (--se cr2) is recommended; CR1 with G − 1 degrees of freedom over-rejects with few \
-             or unbalanced clusters"
+             (the default here, --se cr2); CR1 with G − 1 degrees of freedom (--se cluster) \
+             under-covers with few or unbalanced subjects, and the subject bootstrap is no reliable \
+             reference then either"
         )
     } else {
         format!(
-            "{g} subjects: CR1 (the default) is adequate; CR2 (--se cr2) is the cautious choice \
-             when cluster sizes are very unbalanced"
+            "{g} subjects: CR1 (the default from {CR2_RECOMMENDED_BELOW} subjects on) is \
+             adequate; CR2 (--se cr2) is the cautious choice when subjects' row counts are very \
+             unbalanced"
         )
     };
     InferenceRecord {
