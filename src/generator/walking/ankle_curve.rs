@@ -1,6 +1,8 @@
 //! Swing1's ankle curve `P` (§4.3: a 4th-order polynomial through five conditions) and the knee
 //! slaved to it: the knee angle that puts the ankle on the curve, continuing its branch.
-use super::swing::PEAK_AT;
+
+/// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
+pub(super) const PEAK_AT: f64 = 0.3;
 
 /// The ankle curve `P` of swing1: `y(x) = Σ c_i x^i`, x measured from the ankle at toe-off.
 #[derive(Debug, Clone, Copy, PartialEq)]

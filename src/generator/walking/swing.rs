@@ -25,6 +25,7 @@
 //!
 //! The foot is kinematic: the ankle angle θ5 and the toe bend θ6 are interpolated (C¹) between
 //! their toe-off and heel-strike values.
+use super::ankle_curve::PEAK_AT;
 pub use super::ankle_curve::{knee_on_circle, AnkleCurve, KNEE_BRANCH_STEP};
 use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
@@ -244,9 +245,6 @@ fn hermite(a: f64, b: f64, p0: [f64; 2], p1: [f64; 2], t: f64) -> [f64; 3] {
     let (v, d, dd) = crate::generator::curves::hermite_acc(a, b, p0[0], p1[0], p0[1], p1[1], t);
     [v, d, dd]
 }
-
-/// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
-pub(super) const PEAK_AT: f64 = 0.3;
 
 /// Least fraction of the ankle's way from toe-off to heel strike covered by the end of swing1.
 const MIN_TRAVEL: f64 = 0.3;

@@ -24,7 +24,6 @@
 //! in 3D reaches its ankle exactly.
 use super::attributes::WalkAttributes;
 use super::body::Body;
-pub use super::draw::smooth_roll;
 use super::foot::{toe_blend, FootShape};
 use crate::generator::curves::smoothstep;
 use std::f64::consts::FRAC_PI_2;
