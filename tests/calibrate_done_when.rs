@@ -2,7 +2,10 @@
 //! - Hamner et al. (2013) subject01 Run_3 calibrated: cadence within 2 %, step length within
 //!   3 %, flight within 15 ms of the measured (force plates), knee angle RMS reported;
 //! - Schreiber & Moissenet (2019) 2014001 (C4 and C5, one calibration for both speeds): double
-//!   support within 1 % of the cycle of the measured (the file's foot-strike/foot-off events).
+//!   support within 1 % of the cycle of the measured (the file's foot-strike/foot-off events);
+//!   and its Ko–Badler stage (each speed generalized from the subject's walk at the other):
+//!   the rendered walk, measured by the event pipeline, has the commanded (measured) step length
+//!   and cadence within 1 %, and its joint-angle RMS are reported.
 //!
 //! The references are the measured trials, not gaitfit's earlier output. Ignored by default
 //! (needs ../shared/data); a few seconds.
@@ -12,6 +15,11 @@ use std::process::Command;
 
 /// (quantity, speed rounded to cm/s) → (measured, generated) of stage `calibrated`.
 fn calibrated(dir: &Path) -> HashMap<(String, i64), (f64, f64)> {
+    stage(dir, "calibrated")
+}
+
+/// (quantity, speed rounded to cm/s) → (measured, generated) of stage `which`.
+fn stage(dir: &Path, which: &str) -> HashMap<(String, i64), (f64, f64)> {
     let text = std::fs::read_to_string(dir.join("residuals.csv")).expect("residuals.csv");
     let mut lines = text.lines();
     let head: Vec<&str> = lines.next().expect("header").split(',').collect();
@@ -26,7 +34,7 @@ fn calibrated(dir: &Path) -> HashMap<(String, i64), (f64, f64)> {
     let mut out = HashMap::new();
     for l in lines {
         let f: Vec<&str> = l.split(',').collect();
-        if f[st] != "calibrated" {
+        if f[st] != which {
             continue;
         }
         let num = |i: usize| f[i].parse::<f64>().unwrap_or(f64::NAN);
@@ -98,5 +106,24 @@ fn schreiber_2014001_double_support() {
             v as f64 / 100.0
         );
         assert!((g - m).abs() < 1.0, "{v} cm/s: {g} vs {m} % cycle");
+    }
+    let kb = stage(tmp.path(), "ko-badler");
+    for q in ["step_length_m", "cadence_steps_per_min"] {
+        let rows: Vec<_> = kb.iter().filter(|(k, _)| k.0 == q).collect();
+        assert_eq!(rows.len(), 2, "Ko–Badler {q} at C4 and C5: {kb:?}");
+        for ((_, v), (m, g)) in rows {
+            println!("Ko–Badler {v} cm/s: {q} {m:.4} → {g:.4}");
+            assert!((g - m).abs() < 0.01 * m, "Ko–Badler {q} {g} vs {m}");
+        }
+    }
+    for q in [
+        "hip_flexion_rms_deg",
+        "knee_flexion_rms_deg",
+        "ankle_dorsiflexion_rms_deg",
+    ] {
+        for ((name, v), (_, g)) in kb.iter().filter(|(k, _)| k.0 == q) {
+            println!("Ko–Badler {v} cm/s: {name} {g:.1}");
+            assert!(g.is_finite(), "{name} {g}");
+        }
     }
 }

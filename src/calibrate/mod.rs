@@ -12,6 +12,7 @@
 //! [`drive::RUN_ATTRS`] / [`drive::WALK_ATTRS`] found by Gauss–Newton, argmin's
 //! `GaussNewton`, on the objective of [`solve`]).
 pub mod drive;
+pub mod kb;
 pub mod measure;
 pub mod output;
 pub mod solve;
@@ -366,6 +367,9 @@ pub struct SubjectResult {
     pub iterations: u64,
     /// Objective evaluations.
     pub evaluations: usize,
+    /// Stage `ko-badler` (walks with another condition of the subject): each condition
+    /// generalized from the subject's walk at the nearest other speed ([`kb`]).
+    pub kb: Option<solve::Stage>,
 }
 
 /// Everything one `calibrate` run found.
@@ -394,7 +398,8 @@ pub fn calibrate(
     let n = subjects.len();
     let mut out = Vec::new();
     for (i, s) in subjects.into_iter().enumerate() {
-        let r = solve::calibrate_subject(s, &rel, opts)?;
+        let mut r = solve::calibrate_subject(s, &rel, opts)?;
+        r.kb = kb::kb_stage(&r.subject, opts.drive.fps, opts.drive.steps);
         progress(i + 1, n, &r);
         out.push(r);
     }

@@ -2,7 +2,7 @@
 //! (one self-contained file, inline SVG, nothing from the network).
 use super::drive::attr_defs;
 use super::measure::{rms_corr, Curves, Measurement, CYCLE_POINTS};
-use super::solve::{value, Stage};
+use super::solve::value;
 use super::{CalibrateError, CalibratedAttr, CalibratedFile, CalibratedSubject, Calibration};
 use crate::events::Gait;
 use std::fmt::Write as _;
@@ -50,7 +50,11 @@ pub fn residual_rows(cal: &Calibration) -> Vec<ResidualRow> {
     let mut out = Vec::new();
     for r in &cal.subjects {
         let s = &r.subject;
-        for (stage_name, stage) in [("relations", &r.before), ("calibrated", &r.after)] {
+        let mut stages = vec![("relations", &r.before), ("calibrated", &r.after)];
+        if let Some(kb) = &r.kb {
+            stages.push(("ko-badler", kb));
+        }
+        for (stage_name, stage) in stages {
             for (c, cond) in s.conditions.iter().enumerate() {
                 let m = &cond.measured;
                 let g = stage.generated[c].as_ref().ok();
@@ -245,7 +249,8 @@ fn curve_svg(title: &str, series: &[(&str, &str, bool, &[f64])]) -> String {
             pts.join(" ")
         );
         let ly = h - 6.0;
-        let lx = ml + 110.0 * n as f64;
+        // Up to 110 px per legend entry, fewer when more series share the width.
+        let lx = ml + ((w - ml - mr) / series.len() as f64).min(110.0) * n as f64;
         let _ = write!(
             s,
             "<line x1=\"{lx}\" y1=\"{ly}\" x2=\"{}\" y2=\"{ly}\" stroke=\"{colour}\"{}/>\
@@ -304,7 +309,10 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
          attributes; stage <i>calibrated</i>: the per-subject attributes found by Gauss–Newton on \
          the weighted residual objective (weights: the measured step-to-step SD; cadence, step \
          length, flight or double support and pelvis excursion — the contact time is reported, not \
-         fitted, being the step time and the flight or double support together).</p>",
+         fitted, being the step time and the flight or double support together); stage \
+         <i>Ko–Badler</i> (walks with another condition of the subject): each condition generalized \
+         (Ko &amp; Badler 1993, paper's μ-functions) from the subject's own walk at the nearest other \
+         speed to the measured step length and duration, nothing calibrated.</p>",
         esc(&cal.relations_source),
         cal.drive.fps,
         cal.drive.steps
@@ -353,7 +361,16 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         }
         h.push_str("</table>");
         // Residual table.
-        h.push_str("<table><tr><th>trial</th><th>speed m/s</th><th>quantity</th><th>measured</th><th>relations (resid.)</th><th>calibrated (resid.)</th></tr>");
+        let kb_head = if r.kb.is_some() {
+            "<th>Ko–Badler (resid.)</th>"
+        } else {
+            ""
+        };
+        let _ = write!(h, "<table><tr><th>trial</th><th>speed m/s</th><th>quantity</th><th>measured</th><th>relations (resid.)</th><th>calibrated (resid.)</th>{kb_head}</tr>");
+        let kb_cell = |c: usize, f: &dyn Fn(&Result<Measurement, String>) -> String| match &r.kb {
+            Some(kb) => format!("<td>{}</td>", f(&kb.generated[c])),
+            None => String::new(),
+        };
         for (c, cond) in s.conditions.iter().enumerate() {
             let m = &cond.measured;
             for (q, (name, unit, _)) in scalar_quantities(s.gait).iter().enumerate() {
@@ -364,14 +381,15 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                 let d = if unit == &"m" || unit == &"s" { 3 } else { 1 };
                 let _ = write!(
                     h,
-                    "<tr><td>{}</td><td>{:.2}</td><td>{} [{}]</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+                    "<tr><td>{}</td><td>{:.2}</td><td>{} [{}]</td><td>{}</td><td>{}</td><td>{}</td>{}</tr>",
                     esc(&cond.trial),
                     cond.speed(),
                     name,
                     esc(unit),
                     fmt(mv, d),
                     stage_cell(&r.before.generated[c], q, d, mv),
-                    stage_cell(&r.after.generated[c], q, d, mv)
+                    stage_cell(&r.after.generated[c], q, d, mv),
+                    kb_cell(c, &|g| stage_cell(g, q, d, mv))
                 );
             }
             if let Some(mc) = &m.curves {
@@ -379,7 +397,7 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                     .iter()
                     .enumerate()
                 {
-                    let cell = |st: &Stage| match st.generated[c]
+                    let cell = |g: &Result<Measurement, String>| match g
                         .as_ref()
                         .ok()
                         .and_then(|g| g.curves.as_ref())
@@ -393,13 +411,14 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                     };
                     let _ = write!(
                         h,
-                        "<tr><td>{}</td><td>{:.2}</td><td>{} curve</td><td>{} strides</td><td>{}</td><td>{}</td></tr>",
+                        "<tr><td>{}</td><td>{:.2}</td><td>{} curve</td><td>{} strides</td><td>{}</td><td>{}</td>{}</tr>",
                         esc(&cond.trial),
                         cond.speed(),
                         name,
                         mc.strides,
-                        cell(&r.before),
-                        cell(&r.after)
+                        cell(&r.before.generated[c]),
+                        cell(&r.after.generated[c]),
+                        kb_cell(c, &cell)
                     );
                 }
             }
@@ -417,6 +436,10 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                 .as_ref()
                 .ok()
                 .and_then(|g| g.curves.as_ref());
+            let gk =
+                r.kb.as_ref()
+                    .and_then(|kb| kb.generated[c].as_ref().ok())
+                    .and_then(|g| g.curves.as_ref());
             for k in 0..3 {
                 let mut series: Vec<(&str, &str, bool, &[f64])> =
                     vec![("measured", "#000", false, curve_pairs(mc, mc)[k].1)];
@@ -425,6 +448,9 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                 }
                 if let Some(g) = ga {
                     series.push(("calibrated", "#d62728", false, curve_pairs(g, g)[k].1));
+                }
+                if let Some(g) = gk {
+                    series.push(("Ko–Badler", "#2ca02c", true, curve_pairs(g, g)[k].1));
                 }
                 let title = format!(
                     "{} {:.2} m/s: {} (deg)",
@@ -438,6 +464,14 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         h.push_str("</div>");
         let mut gen_notes = r.after.notes.clone();
         gen_notes.extend(r.before.notes.iter().cloned());
+        if let Some(kb) = &r.kb {
+            gen_notes.extend(kb.notes.iter().cloned());
+            for (c, g) in kb.generated.iter().enumerate() {
+                if let Err(e) = g {
+                    gen_notes.push(format!("Ko–Badler {}: {e}", s.conditions[c].trial));
+                }
+            }
+        }
         gen_notes.sort();
         gen_notes.dedup();
         for n in gen_notes.iter().take(8) {

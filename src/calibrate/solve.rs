@@ -290,5 +290,6 @@ pub fn calibrate_subject(
         se,
         iterations: iters,
         evaluations: evals,
+        kb: None,
     })
 }
