@@ -50,7 +50,13 @@ pub struct KinematicOptions {
     /// (default 2): they may be cut by the record, not turning points.
     pub edge_frames: usize,
     /// Foot-speed detector: heel strike when the heel's speed over the ground falls below this
-    /// fraction of the walking speed (default 0.5, Bonci et al. 2022).
+    /// fraction of the walking speed (default 0.5, Bonci et al. 2022). Measured alternative
+    /// (not the default): 0.3, the fraction in 0.20…0.50 with the smallest mean error against
+    /// the plates on Schreiber subjects 2014001/2014004/2014007, finds every plate heel strike
+    /// of the shared walks with markers (Schreiber held out, BMClab), but its SD on the
+    /// held-out Schreiber subjects is 17 ms (11 ms at 0.5) and it shortens a generated KLAW
+    /// walk's double support by 31 ms (tests/klaw_events.rs; tests/events_walk_kinematic.rs
+    /// measures both).
     #[serde(default = "default_hs_fraction")]
     pub hs_speed_fraction: f64,
     /// Foot-speed detector: toe off when the toe's speed over the ground rises above this
@@ -805,8 +811,11 @@ impl Kinematics {
             // Record ends: an event whose Zeni extremum the record cuts has no seed. When the
             // foot's first seed is a toe off the foot was on the ground at the start, so its
             // heel strike may lie just inside the record: a heel seed opens [start, toe off
-            // − 0.2 s]. Likewise a foot whose last seed is a heel strike may lift before the
-            // end ([heel strike + 0.25 s, end]), and one whose last seed is a toe off may land
+            // − 0.2 s]; it finds the heel strike only if the heel is still faster than the
+            // level at the first frame (one Schreiber heel, 2014015_C4_04 left, is at 0.35 ×
+            // speed when the record starts 63 ms before the plate's 20 N: its crossing of 0.5 ×
+            // speed precedes the record, so no event). Likewise a foot whose last seed is a
+            // heel strike may lift before the end ([heel strike + 0.25 s, end]), and one whose last seed is a toe off may land
             // ([toe off + 0.2 s, end]). A window with no crossing gives no event.
             let mine: Vec<&GaitEvent> = seeds.iter().filter(|e| e.side == side).collect();
             let mut extra: Vec<(EventKind, usize, usize)> = Vec::new();
