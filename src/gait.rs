@@ -134,6 +134,9 @@ pub enum EventSource {
     FootJerk,
     /// Read from the input file (e.g. a C3D EVENT group); kept for comparison, never overwritten.
     Reference,
+    /// The file's events with the force plates' in place wherever the plates saw the event
+    /// (each event keeps its own source: `Force` or `Reference`).
+    ForceThenReference,
     /// Produced by one of gaitfit's generators.
     Generated,
 }
@@ -151,6 +154,7 @@ impl EventSource {
             EventSource::FootSpeed => "foot_speed",
             EventSource::FootJerk => "foot_jerk",
             EventSource::Reference => "reference",
+            EventSource::ForceThenReference => "force_then_reference",
             EventSource::Generated => "generated",
         }
     }

@@ -9,8 +9,8 @@
 //! monotonically and never occur in mid swing: the foot is still loaded; see the script's
 //! "dropout evidence"). Ending a contact at its first zeroed sample instead gives the
 //! `naive_double_support_mean_s` column (0.066/0.059/0.050/0.050 s), the figures issue 19 quotes
-//! as 0.070/0.060/0.050/0.047 s; gaitfit is compared with the bridged reference, and the naive
-//! figure is printed beside it.
+//! as 0.070/0.060/0.050/0.047 s; gaitfit is compared with the bridged reference, and, with
+//! `bridge_dropouts = false` (`--no-bridge`), with the naive reference and the issue's figures.
 use gaitfit::events::{analyse, steps_from_analysis, EventKind, EventOptions, GaitEvent, Side};
 use gaitfit::ingest::{read_trial, ReadOptions};
 use gaitfit::shared_data::require;
@@ -112,6 +112,55 @@ fn wbds04_events_and_double_support_match_20_n_on_the_unfiltered_force() {
         assert!(
             (mean - want).abs() <= DOUBLE_SUPPORT_TOL_S,
             "{trial}: double support {mean:.4} s, reference {want:.4} s"
+        );
+    }
+}
+
+/// Issue 19's WBDS04 double support (T05…T08), s: a plain 20 N threshold on the exported force.
+const ISSUE_NAIVE_DS_S: [(&str, f64); 4] = [
+    ("WBDS04walkT05", 0.070),
+    ("WBDS04walkT06", 0.060),
+    ("WBDS04walkT07", 0.050),
+    ("WBDS04walkT08", 0.047),
+];
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn wbds04_without_bridging_reproduces_the_naive_reference_and_the_issue_figures() {
+    let root = require("wbds");
+    let ds = tool_csv("wbds04_double_support.csv");
+    for (trial, issue) in ISSUE_NAIVE_DS_S {
+        let row = ds.iter().find(|r| r[0] == trial).unwrap();
+        let path = root.join(format!("{trial}grf.txt"));
+        let t = read_trial(&path, &ReadOptions::default()).unwrap();
+        let mut opts = EventOptions::default();
+        opts.force.bridge_dropouts = false;
+        let an = analyse(&t, &opts).unwrap();
+        let steps = steps_from_analysis(&t, &an, &opts).unwrap();
+        let d: Vec<f64> = steps
+            .rows
+            .iter()
+            .filter_map(|r| r.double_support_time_s)
+            .collect();
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        let naive: f64 = row[5].parse().unwrap();
+        let bridged: f64 = row[2].parse().unwrap();
+        println!(
+            "{trial}: not bridged {mean:.4} s ({} steps); numpy naive {naive:.4} s, issue \
+             {issue:.3} s; bridged reference {bridged:.4} s",
+            d.len()
+        );
+        assert!(
+            (mean - naive).abs() <= 0.002,
+            "{trial}: not bridged {mean:.4} s, numpy naive {naive:.4} s"
+        );
+        assert!(
+            (mean - issue).abs() <= DOUBLE_SUPPORT_TOL_S,
+            "{trial}: not bridged {mean:.4} s, issue {issue:.3} s"
+        );
+        assert!(
+            bridged - mean > 0.005,
+            "{trial}: bridging should lengthen it"
         );
     }
 }

@@ -51,7 +51,11 @@ pub struct Args {
     /// foot-speed for walks, foot-jerk for runs), foot-speed (walks: Zeni windows refined by
     /// the heel and toe speed over the ground, Bonci et al. 2022), foot-jerk (runs: heel or
     /// metatarsal impact jerk at touchdown, toe speed over the ground at toe off), zeni,
-    /// zeni-velocity, foot-height, reference.
+    /// zeni-velocity, foot-height, reference (the file's own events, e.g. a C3D's),
+    /// force-then-reference (the plates' events where the plates saw the event — 20 N on the
+    /// unfiltered force, the truth there — and the file's events elsewhere; not yet the auto
+    /// choice for files with both, see reports/events.md). Where a file has its own events and
+    /// plates, their disagreement (file − plates, per kind) is printed on stderr.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
     pub events: String,
     /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
@@ -85,6 +89,11 @@ pub struct Args {
     /// Subtract a linear baseline from drifting force plates instead of failing.
     #[arg(long)]
     pub correct_drift: bool,
+    /// Time each force contact on the first run of the unfiltered force above --off lasting
+    /// 50 ms, instead of bridging samples an export zeroed in the unloading tail (WBDS): what a
+    /// plain threshold on the exported force gives; for comparison only (reports/events.md).
+    #[arg(long)]
+    pub no_bridge: bool,
     /// Marker low-pass cutoff, Hz.
     #[arg(long, default_value_t = 6.0)]
     pub marker_cutoff: f64,
@@ -105,7 +114,7 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     opts.primary = PrimarySource::parse(&args.events).with_context(|| {
         format!(
             "--events {}: use auto, force, kinematic, foot-speed, foot-jerk, zeni, \
-             zeni-velocity, foot-height or reference",
+             zeni-velocity, foot-height, reference or force-then-reference",
             args.events
         )
     })?;
@@ -131,6 +140,7 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     opts.force.on_n = args.on;
     opts.force.off_n = args.off;
     opts.force.correct_drift = args.correct_drift;
+    opts.force.bridge_dropouts = !args.no_bridge;
     opts.kinematic.cutoff_hz = args.marker_cutoff;
     Ok((read, opts))
 }
@@ -141,6 +151,8 @@ struct TrialResult {
     compare: CompareTable,
     notes: Vec<String>,
     label: String,
+    /// File event − plate event, s, per event the plates also saw.
+    reference_minus_force_s: Vec<(crate::events::EventKind, f64)>,
 }
 
 fn process(
@@ -187,6 +199,7 @@ fn process(
         compare,
         notes,
         label: input.label(),
+        reference_minus_force_s: an.events.reference_minus_force_s.clone(),
     })
 }
 
@@ -254,6 +267,50 @@ fn summary(results: &[TrialResult]) -> String {
         ));
     }
     s
+}
+
+/// Prints, on stderr, how the files' own events disagree with the plates where both saw an
+/// event (file − plate, mean ± SD per kind over the batch), when any trial had both.
+fn print_reference_disagreement(results: &[TrialResult]) {
+    use crate::events::EventKind;
+    let trials = results
+        .iter()
+        .filter(|r| !r.reference_minus_force_s.is_empty())
+        .count();
+    if trials == 0 {
+        return;
+    }
+    let part = |kind: EventKind| -> String {
+        let v: Vec<f64> = results
+            .iter()
+            .flat_map(|r| &r.reference_minus_force_s)
+            .filter(|(k, _)| *k == kind)
+            .map(|(_, d)| d * 1e3)
+            .collect();
+        format!("{kind} {} ms (n {})", mean_sd_signed(&v), v.len())
+    };
+    eprintln!(
+        "gaitfit events: the files' own events − the plates' (20 N on the unfiltered force), {} \
+         trial(s): {}, {}",
+        trials,
+        part(EventKind::HeelStrike),
+        part(EventKind::ToeOff)
+    );
+}
+
+/// `+m.m ± s.s` of `v` (`–` when empty).
+fn mean_sd_signed(v: &[f64]) -> String {
+    if v.is_empty() {
+        return "–".into();
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let sd = if v.len() > 1 {
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    format!("{m:+.1} ± {sd:.1}")
 }
 
 /// Runs `gaitfit events`.
@@ -346,6 +403,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             }
         }
     }
+    print_reference_disagreement(&ok);
     if compare_with.is_some() {
         let mut all = CompareTable::default();
         for r in &ok {

@@ -18,7 +18,9 @@
 //!    an edge) of the filtered contact's edge: heel strike at the first sample of the contact
 //!    at or above the level (extended backward while the force stays at or above it), toe off
 //!    after its last, so isolated dropout samples inside a contact (the WBDS export zeroes
-//!    some) do not cut it short.
+//!    some) do not cut it short (`bridge_dropouts = false` takes the first run of the
+//!    unfiltered force at or above the level lasting `min_contact_s` instead, for comparison
+//!    with figures computed that way).
 //!
 //! Plates that carry one known foot (dual-belt treadmill belts, OpenSim `R_`/`L_` forces) give
 //! that foot's events directly. Overground plates (`side: None`) are assigned to a foot by the
@@ -57,6 +59,18 @@ pub struct ForceOptions {
     pub drift_tolerance_n: f64,
     /// Subtract a linear baseline fitted to the unloaded periods instead of failing on drift.
     pub correct_drift: bool,
+    /// Bridge dropouts at toe off (default `true`): a contact's toe off is timed after the
+    /// last unfiltered sample at or above `off_n` near the filtered contact's end, so samples
+    /// an export zeroed in the unloading tail (WBDS) do not end it. `false` times the contact
+    /// on the first run of the unfiltered force at or above `off_n` lasting `min_contact_s`:
+    /// what a plain threshold on the exported force gives (issue 19's WBDS04 double support
+    /// figures).
+    #[serde(default = "default_bridge")]
+    pub bridge_dropouts: bool,
+}
+
+fn default_bridge() -> bool {
+    true
 }
 
 impl Default for ForceOptions {
@@ -71,6 +85,7 @@ impl Default for ForceOptions {
             min_gap_s: 0.05,
             drift_tolerance_n: 10.0,
             correct_drift: false,
+            bridge_dropouts: true,
         }
     }
 }
@@ -381,6 +396,35 @@ fn retime(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions, contacts: &mut [
         } else {
             n - 1
         };
+        if !opts.bridge_dropouts {
+            // No bridging: the contact is the first run of the timing signal at or above the
+            // level, at least `min_contact_s` long, in the edges' search range (a plain
+            // threshold on the exported force, shorter runs dropped as blips).
+            let (lo, hi) = (floor.max(s.saturating_sub(w)), ceil.min(e + w));
+            let mut j = lo;
+            while j <= hi {
+                if g[j] < level {
+                    j += 1;
+                    continue;
+                }
+                let a = j;
+                while j < hi && g[j + 1] >= level {
+                    j += 1;
+                }
+                // A run the record cuts is a contact of unknown length.
+                if t[j] - t[a] >= opts.min_contact_s || a == 0 || j + 1 >= n {
+                    if contacts[k].2.is_some() && a > 0 {
+                        contacts[k].2 = Some(crossing(t, g, a - 1, level));
+                    }
+                    if contacts[k].3.is_some() && j + 1 < n {
+                        contacts[k].3 = Some(crossing(t, g, j, level));
+                    }
+                    break;
+                }
+                j += 1;
+            }
+            continue;
+        }
         if contacts[k].2.is_some() {
             let lo = floor.max(s.saturating_sub(w));
             if let Some(mut j) = (lo..=e).find(|&j| g[j] >= level) {

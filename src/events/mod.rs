@@ -171,6 +171,9 @@ pub enum PrimarySource {
     Kinematic,
     /// The events stored in the file (C3D EVENT group).
     Reference,
+    /// The force plates' events where the plates saw the event (20 N on the unfiltered force),
+    /// the file's events elsewhere (see [`force_then_reference`]).
+    ForceThenReference,
 }
 
 impl PrimarySource {
@@ -187,6 +190,9 @@ impl PrimarySource {
             "foot-speed" | "speed" | "bonci" => Some(Self::FootSpeed),
             "foot-jerk" | "jerk" | "run-foot" => Some(Self::FootJerk),
             "reference" | "c3d" => Some(Self::Reference),
+            "force-then-reference" | "force+reference" | "plates-then-reference" => {
+                Some(Self::ForceThenReference)
+            }
             _ => None,
         }
     }
@@ -260,6 +266,14 @@ pub struct TrialEvents {
     pub phases: Vec<GaitEvent>,
     /// Events read from the file (kept, never overwritten).
     pub reference: Vec<GaitEvent>,
+    /// The file's measured events with the plates' in place where the plates saw the event
+    /// (see [`force_then_reference`]); empty without both.
+    #[serde(default)]
+    pub force_then_reference: Vec<GaitEvent>,
+    /// File event − plate event, s, for every file event the plates also saw (matched within
+    /// [`compare::DEFAULT_TOLERANCE_S`], same foot and kind).
+    #[serde(default)]
+    pub reference_minus_force_s: Vec<(EventKind, f64)>,
     /// The source the steps are built from.
     pub primary: EventSource,
     /// What was assumed or found (axes, marker roles, baseline offsets, dropped events).
@@ -277,6 +291,7 @@ impl TrialEvents {
             EventSource::FootSpeed => &self.foot_speed,
             EventSource::FootJerk => &self.foot_jerk,
             EventSource::Reference => &self.reference,
+            EventSource::ForceThenReference => &self.force_then_reference,
             EventSource::Generated => &[],
         }
     }
@@ -348,6 +363,8 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         walking,
         phases: Vec::new(),
         reference: trial.reference_events.clone(),
+        force_then_reference: Vec::new(),
+        reference_minus_force_s: Vec::new(),
         primary: EventSource::Force,
         notes,
     };
@@ -357,6 +374,12 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
             what: "markers, force plates and reference events: nothing to detect events from"
                 .into(),
         });
+    }
+    if measured(&ev.reference) && !ev.reference.is_empty() && !ev.force.is_empty() {
+        let (merged, diffs) =
+            force_then_reference(&ev.force, &ev.reference, compare::DEFAULT_TOLERANCE_S);
+        ev.force_then_reference = merged;
+        ev.reference_minus_force_s = diffs;
     }
     ev.primary = choose_primary(&ev, opts.primary, &path)?;
     if let Some(k) = &kin {
@@ -426,6 +449,57 @@ fn measured(ev: &[GaitEvent]) -> bool {
     ev.iter().all(|e| e.source != EventSource::Generated)
 }
 
+/// The file's events with the plates' in their place wherever the plates saw the event: each
+/// plate heel strike or toe off replaces the file's event of the same foot and kind nearest to
+/// it within `tol_s` (each file event replaced at most once); a plate event with no file
+/// partner is added (the plates saw it, the file lacks it). The plates are the truth where
+/// they see the event (20 N on the unfiltered vertical force; on Schreiber & Moissenet 2019
+/// the files' toe offs are 14 ms late on average, up to 85 ms — reports/events.md); the file's
+/// events fill in the contacts beside the plates. Returns the merged events in time order and
+/// file − plate, s, per matched pair.
+pub fn force_then_reference(
+    force: &[GaitEvent],
+    reference: &[GaitEvent],
+    tol_s: f64,
+) -> (Vec<GaitEvent>, Vec<(EventKind, f64)>) {
+    let mut out: Vec<GaitEvent> = reference.to_vec();
+    let mut taken = vec![false; out.len()];
+    let mut diffs = Vec::new();
+    for f in force
+        .iter()
+        .filter(|e| matches!(e.kind, EventKind::HeelStrike | EventKind::ToeOff))
+    {
+        let best = out
+            .iter()
+            .enumerate()
+            .filter(|(i, r)| {
+                !taken[*i]
+                    && r.side == f.side
+                    && r.kind == f.kind
+                    && (r.time_s - f.time_s).abs() <= tol_s
+            })
+            .min_by(|a, b| {
+                (a.1.time_s - f.time_s)
+                    .abs()
+                    .total_cmp(&(b.1.time_s - f.time_s).abs())
+            })
+            .map(|(i, _)| i);
+        match best {
+            Some(i) => {
+                diffs.push((f.kind, out[i].time_s - f.time_s));
+                out[i] = *f;
+                taken[i] = true;
+            }
+            None => {
+                out.push(*f);
+                taken.push(true);
+            }
+        }
+    }
+    out.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    (out, diffs)
+}
+
 fn has_both_kinds(ev: &[GaitEvent]) -> bool {
     ev.iter().any(|e| e.kind == EventKind::HeelStrike)
         && ev.iter().any(|e| e.kind == EventKind::ToeOff)
@@ -475,6 +549,10 @@ fn choose_primary(
             }
         }
         PrimarySource::Reference => need(EventSource::Reference, "the file's reference events"),
+        PrimarySource::ForceThenReference => need(
+            EventSource::ForceThenReference,
+            "the force plates together with the file's measured events",
+        ),
         PrimarySource::Auto => {
             // The file's own events come before the Zeni estimate: on the shared overground
             // data the Zeni heel strike precedes the force-plate contact by 30–40 ms (the heel
