@@ -36,6 +36,33 @@ events build them) is in the `data/*.csv` tables.
 
 ## Findings
 
+- **Issue 19, second pass (this session).**
+  - *Walking heel strikes at record starts.* Every Schreiber record starts ~0.05 s before a
+    plate heel strike. The one `foot_speed` misses (2014015_C4_04, left, plate 20 N at
+    0.063 s): the heel's speed over the ground is already 0.35 × walking speed at the first
+    frame (6 Hz filtered; 0.48 × raw), below the 0.5 × level, so the crossing lies before the
+    record — extrapolated ≈ −66 ms from the plate, outside the 60 ms tolerance, so padding the
+    filter's edge or a start rule cannot recover it. Cause: this walker's heel slows before the
+    plate loads (heel speed at the plates' heel strike 0.15 × speed on both feet, 0.19–0.55
+    for the others; the right heel strike of the same trial is −41 ms). Default (0.5, Bonci
+    et al. 2022), heel strike vs plates, every plate event in the marker record: Schreiber
+    2014001/004/007 −14.7 ± 9.7 ms, recall 1.000; 2014014/015/019 −10.6 ± 11.2 ms, 0.917;
+    all 12 −12.7 ± 10.4 ms, 0.958 (toe off −12.0 ± 5.8 ms, 1.000); BMClab walk1/2
+    −16.6 ± 9.7 ms, 1.000. Recall ≥ 0.99 including record starts is **not** met by the
+    default. 0.3 × speed (the fraction with the smallest mean error on the first three
+    subjects) meets it on every set (+2.0 ± 7.8, +1.6 ± 17.0, −0.8 ± 8.9 ms, recall 1.000)
+    but with a 17 ms SD on the held-out subjects, and it shortens a generated KLAW walk's
+    double support by 31 ms; it is not the default
+    (`cargo test --release --test events_walk_kinematic -- --include-ignored --nocapture`).
+  - *Reference events vs plates* (the files' own events − the plates' 20 N events, the 12
+    Schreiber trials, n 24 each): heel strike −8.1 ± 6.2 ms, toe off +18.2 ± 8.9 ms
+    (printed on stderr by `gaitfit events` whenever a file has both). `--events
+    force-then-reference` builds the steps from the plates' events where the plates saw the
+    event and the file's events elsewhere (tests/events_reference_plates.rs). It is not yet
+    the `auto` choice: switching changes `data/walk_schreiber2019.csv`, hence `fits/`, the
+    statsmodels references and the KLAW default μ coefficients, owned elsewhere.
+  - *WBDS04 double support, both readings*: section "WBDS04 double support" below.
+
 - **Issue 19 (latest).** Running from markers alone: `foot_jerk` (`--events kinematic` on a
   run) against numpy's 20 N events on Hamner subject01, every event in the record: heel strike
   −3 ± 5 ms (recall 0.98), toe off −4 ± 6 ms (recall 1.00); gaitkit's Zeni toe off +54 ms,
@@ -140,6 +167,28 @@ run "BMClab Gait.c3d (a Vicon C3D walking sample; two plates, one contact each)"
 run "BMClab running trial (one contact per foot)" bmclab/motion_capture_run.trc+bmclab/grf_run.mot --compare force
 run "Hamner subject01 (the runner with markers), treadmill" hamner2013/subject01 --compare force
 run "Schreiber: kinematic methods vs the C3D's own events" schreiber2019 --compare reference
+printf '\n## WBDS04 double support: dropouts bridged or not\n\n'
+cat <<'EOF'
+The WBDS export zeroes every channel of a belt together on some samples; in a contact's
+unloading tail the nonzero samples it leaves after the first zero are the foot's load (they
+fall monotonically — 267 of 270 pairs —, occur only within ~30 ms of the cut, never in mid
+swing: 1 sample above 20 N in 20 232; at the first zero the force drops ~100 N in one sample
+while the other belt's changes as usual). gaitfit bridges them by default (a contact ends after
+its last loaded sample); `--no-bridge` ends it at the first zero, as a plain threshold on the
+export does. Mean double support per trial, s (`tools/events/force_truth.py`, numpy, writes
+`tools/events/wbds04_double_support.csv`; `tests/events_force_timing.rs` checks both):
+
+| trial | gaitfit (bridged) | numpy, joined | gaitfit `--no-bridge` | numpy, naive | issue 19 |
+|---|---|---|---|---|---|
+| T05 (1.30 m/s) | 0.0826 | 0.0827 | 0.0660 | 0.0662 | 0.070 |
+| T06 (1.49 m/s) | 0.0702 | 0.0703 | 0.0587 | 0.0590 | 0.060 |
+| T07 (1.69 m/s) | 0.0611 | 0.0611 | 0.0503 | 0.0498 | 0.050 |
+| T08 (1.88 m/s) | 0.0577 | 0.0575 | 0.0501 | 0.0500 | 0.047 |
+
+The issue's "truth" is the naive reading (gaitfit `--no-bridge` within 4 ms of it and within
+0.5 ms of numpy's naive); the bridged reading is the one the data support, and the default.
+EOF
+run "WBDS subject 04, dropouts not bridged" wbds --summary --no-bridge
 cat <<'EOF'
 
 ## gaitkit 1.5 side by side (issue 19)
