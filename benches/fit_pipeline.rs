@@ -123,7 +123,7 @@ fn bench(c: &mut Criterion) {
     let tables = [t];
     let mut outcomes = Vec::new();
     for r in &rels {
-        outcomes.push(stage(r.id(), &mut total, || {
+        outcomes.push(stage(r.card().id, &mut total, || {
             fit_relation(r.as_ref(), &tables, &opts).expect("fit")
         }));
     }

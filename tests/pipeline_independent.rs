@@ -5,7 +5,7 @@ use gaitfit::fit::inference::SeMethod;
 use gaitfit::fit::pipeline::{fit_relation, FitOptions};
 use gaitfit::fit::synthetic::{synthetic_rows, SyntheticSpec};
 use gaitfit::ingest::trials::TrialsTable;
-use gaitfit::relations::{Relation, RunSlV, RunTflightSf, WalkSlSf, WalkTdsSf};
+use gaitfit::relations::{Inputs, Relation, RunSlV, RunTflightSf, WalkSlSf, WalkTdsSf};
 use nalgebra::{DMatrix, DVector};
 
 const REL: f64 = 1e-9;
@@ -37,11 +37,11 @@ fn normal_equations(x: &DMatrix<f64>, y: &DVector<f64>) -> DVector<f64> {
 
 fn data_of(rel: &dyn Relation, t: &TrialsTable) -> Vec<([f64; 4], f64, String)> {
     (0..t.len())
-        .filter(|&i| t.gait[i] == Some(rel.gait()))
+        .filter(|&i| t.gait[i] == Some(rel.card().gait))
         .filter_map(|i| {
-            rel.observe(&t.values(i))
+            rel.observe(&t.values(i), 0)
                 .ok()
-                .map(|o| (o.x, o.y, t.subject_name(i).to_string()))
+                .map(|o| (o.x.values, o.y, t.subject_name(i).to_string()))
         })
         .collect()
 }
@@ -298,11 +298,15 @@ fn run_tflight_sf_continuous_matches_a_substituted_normal_equation_fit() {
     let beta = normal_equations(&x, &y);
     let cub = |x: f64| (0..4).map(|j| beta[j] * w(x).powi(j as i32)).sum::<f64>();
     let quad = |x: f64| cub(k1) + beta[4] * (w(x) - w1) + beta[5] * (w(x).powi(2) - w1 * w1);
-    let r = o.refit.as_ref();
+    let r = &o.refit;
     // Above k2 the model is the plateau cubic(k2).
     for sf in [150.0, 170.0, 179.0, k1, 190.0, 210.0, 229.0, 240.0] {
         let want = if sf < k1 { quad(sf) } else { cub(sf.min(k2)) };
-        close(r.predict(&[sf]), want, &format!("t_flight({sf})"));
+        close(
+            r.predict(&Inputs::new(&[sf])),
+            want,
+            &format!("t_flight({sf})"),
+        );
     }
     let jump = o
         .record

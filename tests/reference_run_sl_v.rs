@@ -1,6 +1,6 @@
 //! Reference tests for `run-sl-v` against the running paper's own numbers
 //! (Bruderlin & Calvert 1996, §2.2 eq. 2 and §3.1 / Figure 4).
-use gaitfit::relations::{load_fit, CoefficientSet, Relation, RunSlV};
+use gaitfit::relations::{load_fit, CoefficientSet, Inputs, Relation, RunSlV};
 use std::path::Path;
 
 /// §3.1: "the velocity was locked at 12 km/h … the normally chosen step length of 1.07 m"
@@ -58,15 +58,22 @@ fn plateau_above_v_norm_is_continuous() {
 fn trait_predict_matches_typed_method_and_gradient_is_consistent() {
     let r = RunSlV::published();
     for (v, h) in [(150.0, 1.7), (250.0, 1.85), (450.0, 1.8)] {
-        assert!((r.predict(&[v, h]) - r.step_length(v, h, 0.0)).abs() < 1e-15);
-        let g = r.gradient(r.values(), &[v, h]).unwrap();
+        assert!(
+            (r.predict_with(&r.card().published_values(), 0.0, &Inputs::new(&[v, h]))
+                - r.step_length(v, h, 0.0))
+            .abs()
+                < 1e-15
+        );
+        let g = r
+            .gradient(&r.card().published_values(), &Inputs::new(&[v, h]))
+            .unwrap();
         for (i, gi) in g.iter().enumerate() {
-            let mut p = r.values().to_vec();
+            let mut p = r.card().published_values();
             let e = 1e-6 * p[i].abs().max(1e-3);
             p[i] += e;
-            let up = r.predict_with(&p, 0.0, &[v, h]);
+            let up = r.predict_with(&p, 0.0, &Inputs::new(&[v, h]));
             p[i] -= 2.0 * e;
-            let dn = r.predict_with(&p, 0.0, &[v, h]);
+            let dn = r.predict_with(&p, 0.0, &Inputs::new(&[v, h]));
             assert!(
                 ((up - dn) / (2.0 * e) - gi).abs() < 1e-6,
                 "param {i} at v={v}"
@@ -88,8 +95,8 @@ fn loads_refitted_coefficients_and_levels_from_a_fits_file() {
     assert_eq!(r.level("S01"), 0.0005);
     assert_eq!(r.level("nobody"), 0.0);
     let dynr = load_fit(&p).unwrap();
-    assert_eq!(dynr.id(), "run-sl-v");
-    assert!((dynr.predict(&[200.0, 1.8]) - (0.2 + 0.004 * 200.0)).abs() < 1e-12);
+    assert_eq!(dynr.card().id, "run-sl-v");
+    assert!((dynr.predict(&Inputs::new(&[200.0, 1.8])) - (0.2 + 0.004 * 200.0)).abs() < 1e-12);
     // Wrong relation or a missing coefficient are clear errors.
     let set = CoefficientSet::from_fit_json(
         Path::new("x.json"),

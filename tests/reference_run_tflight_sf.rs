@@ -1,6 +1,6 @@
 //! Reference tests for `run-tflight-sf` against the running paper (Bruderlin & Calvert 1996,
 //! §2.2 eqs. 4–5, §3.1).
-use gaitfit::relations::{load_fit, Continuity, Relation, RunTflightSf};
+use gaitfit::relations::{load_fit, Continuity, Inputs, Relation, RunTflightSf};
 
 /// t_flight(187) from eq. 4 with the published coefficients: −8.925 + 0.131·187 − 0.623e-3·187²
 /// + 0.979e-6·187³ = 0.18818 s (≈ 0.188 s).
@@ -23,7 +23,7 @@ fn the_published_pieces_jump_at_180() {
     assert!((below - 0.14793).abs() < 1e-5, "{below}");
     assert!((at - 0.17933).abs() < 1e-5, "{at}");
     assert!((r.jump_at_k1() - (at - below)).abs() < 1e-7);
-    let d = r.derived(r.values());
+    let d = r.derived(&r.card().published_values());
     assert_eq!(d[0].0, "jump_at_k1");
 }
 
@@ -35,7 +35,10 @@ fn pieces_and_plateau() {
     assert_eq!(r.flight_time(260.0), r.flight_time(230.0));
     let t170 = -0.675e-3 - 0.15e-3 * 170.0 + 0.542e-5 * 170f64.powi(2);
     assert!((r.flight_time(170.0) - t170).abs() < 1e-15);
-    assert!((r.predict(&[170.0]) - t170).abs() < 1e-15);
+    assert!(
+        (r.predict_with(&r.card().published_values(), 0.0, &Inputs::new(&[170.0])) - t170).abs()
+            < 1e-15
+    );
     // "reaches a maximum at about 190 steps/min after which it levels off slightly"
     let peak = (1800..2300)
         .map(|i| i as f64 / 10.0)
@@ -46,9 +49,9 @@ fn pieces_and_plateau() {
 
 #[test]
 fn variants_have_their_own_ids_and_load_from_fits_files() {
-    assert_eq!(RunTflightSf::published().id(), "run-tflight-sf");
+    assert_eq!(RunTflightSf::published().card().id, "run-tflight-sf");
     let c = RunTflightSf::published_continuous();
-    assert_eq!(c.id(), "run-tflight-sf-continuous");
+    assert_eq!(c.card().id, "run-tflight-sf-continuous");
     assert_eq!(c.continuity(), Continuity::Continuous);
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("f.json");
@@ -70,5 +73,5 @@ fn variants_have_their_own_ids_and_load_from_fits_files() {
     let r = RunTflightSf::from_fit_file(&p).unwrap();
     assert_eq!(r.continuity(), Continuity::Continuous);
     assert!((r.flight_time(187.0) - RunTflightSf::published().flight_time(187.0)).abs() < 1e-15);
-    assert_eq!(load_fit(&p).unwrap().id(), "run-tflight-sf-continuous");
+    assert_eq!(load_fit(&p).unwrap().card().id, "run-tflight-sf-continuous");
 }

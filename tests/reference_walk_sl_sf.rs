@@ -1,6 +1,6 @@
 //! Reference tests for `walk-sl-sf` against the walking paper (Bruderlin & Calvert 1989, §3
 //! eq. 1, Figure 10).
-use gaitfit::relations::{Relation, WalkSlSf};
+use gaitfit::relations::{Inputs, Relation, WalkSlSf};
 
 const V_5_KM_PER_H: f64 = 5000.0 / 60.0; // m/min
 
@@ -15,7 +15,10 @@ fn five_km_per_h_at_1_8_m() {
     // eq. 1 itself: sl/(sf·h) = 0.004.
     assert!((sl / (sf * 1.8) - 0.004).abs() < 1e-15);
     assert!((w.step_length(sf, 1.8) - sl).abs() < 1e-12);
-    assert!((w.predict(&[sf, 1.8]) - sl).abs() < 1e-12);
+    assert!(
+        (w.predict_with(&w.card().published_values(), 0.0, &Inputs::new(&[sf, 1.8])) - sl).abs()
+            < 1e-12
+    );
 }
 
 /// Figure 10: three walks at v = 5 km/h with step lengths 0.50 m and 1.05 m besides the natural
@@ -32,7 +35,10 @@ fn figure_10_step_frequencies() {
 #[test]
 fn through_the_origin_and_inverse() {
     let w = WalkSlSf::published();
-    assert!(!w.has_intercept());
-    assert_eq!(w.predict(&[0.0, 1.8]), 0.0);
+    assert!(!w.card().has_intercept);
+    assert_eq!(
+        w.predict_with(&w.card().published_values(), 0.0, &Inputs::new(&[0.0, 1.8])),
+        0.0
+    );
     assert!((w.step_freq(w.step_length(120.0, 1.7), 1.7) - 120.0).abs() < 1e-12);
 }

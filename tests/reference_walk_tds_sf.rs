@@ -1,6 +1,6 @@
 //! Reference tests for `walk-tds-sf` against the walking paper (Bruderlin & Calvert 1989, §3:
 //! t_ds = (−0.16·sf + 29.08)·t_cycle/100, t_cycle = 2/sf).
-use gaitfit::relations::{Relation, WalkTdsSf};
+use gaitfit::relations::{Inputs, Relation, WalkTdsSf};
 
 #[test]
 fn published_formula() {
@@ -14,7 +14,10 @@ fn published_formula() {
     // "As t_ds vanishes, walking becomes running": at 29.08/0.16 = 181.75 steps/min, just under
     // KLAW's sf_max = 182.
     assert!(w.double_support_pct(181.75).abs() < 1e-12);
-    assert!((w.predict(&[100.0]) - 13.08).abs() < 1e-12);
+    assert!(
+        (w.predict_with(&w.card().published_values(), 0.0, &Inputs::new(&[100.0])) - 13.08).abs()
+            < 1e-12
+    );
 }
 
 #[test]

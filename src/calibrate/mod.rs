@@ -318,7 +318,7 @@ pub fn relations(
     })?;
     let rels: Vec<_> = crate::relations::registry()
         .into_iter()
-        .filter(|r| r.id() != "kb-mu")
+        .filter(|r| r.card().id != "kb-mu")
         .collect();
     let run = crate::fit::pipeline::fit_all(
         &rels,

@@ -201,7 +201,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         let r = &o.record;
         let unit = r
             .units
-            .get(o.refit.response().symbol)
+            .get(o.refit.card().response.symbol)
             .cloned()
             .unwrap_or_default();
         // Ko–Badler's α have no published values: its "published" curve is a reference.

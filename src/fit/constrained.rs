@@ -74,7 +74,7 @@ pub fn column_bounds(
     lay: &Layout,
     p: &[f64],
 ) -> Result<Option<ColumnBounds>, FitError> {
-    let specs = rel.parameters();
+    let specs = rel.card().parameters;
     let bounded: Vec<usize> = (0..specs.len())
         .filter(|&i| lay.free[i] && specs[i].kind == ParamKind::Linear)
         .filter(|&i| {
@@ -86,7 +86,7 @@ pub fn column_bounds(
         return Ok(None);
     }
     let bad = |why: &str| FitError::InvalidInput {
-        relation: rel.id().to_string(),
+        relation: rel.card().id.to_string(),
         message: format!("bounded coefficients: {why}"),
     };
     if lay.subj_col.is_some() {
@@ -175,9 +175,9 @@ pub struct OutputStats {
     pub derived: Vec<DerivedRecord>,
 }
 
-fn within_ss(rel: &dyn Relation, prep: &Prepared, w: &[f64], k: usize) -> (usize, f64) {
+fn within_ss(prep: &Prepared, w: &[f64], k: usize) -> (usize, f64) {
     let rows: Vec<usize> = (0..prep.obs.len())
-        .filter(|&i| rel.output_of(&prep.obs[i].x) == k)
+        .filter(|&i| prep.obs[i].x.output == k)
         .collect();
     let sw: f64 = rows.iter().map(|&i| w[i]).sum();
     let mean = rows.iter().map(|&i| w[i] * prep.obs[i].y).sum::<f64>() / sw;
@@ -203,7 +203,7 @@ pub fn output_stats(
     weighted: bool,
     df: f64,
 ) -> Option<OutputStats> {
-    let m = rel.outputs();
+    let m = rel.card().outputs.len();
     if m <= 1 {
         return None;
     }
@@ -223,18 +223,16 @@ pub fn output_stats(
     let ones = vec![1.0; n];
     let w: &[f64] = if weighted { &prep.weights } else { &ones };
     let (mut tss, mut rss, mut prss) = (0.0, 0.0, 0.0);
-    let unit = rel.response().unit;
+    let unit = rel.card().response.unit;
     let mut derived = Vec::new();
     let mut n_groups = 0usize;
     for k in 0..m {
-        let (nk, tk) = within_ss(rel, prep, w, k);
+        let (nk, tk) = within_ss(prep, w, k);
         if nk == 0 {
             continue;
         }
         n_groups += 1;
-        let rows: Vec<usize> = (0..n)
-            .filter(|&i| rel.output_of(&prep.obs[i].x) == k)
-            .collect();
+        let rows: Vec<usize> = (0..n).filter(|&i| prep.obs[i].x.output == k).collect();
         let rk: f64 = rows.iter().map(|&i| w[i] * residuals[i].powi(2)).sum();
         let pk: f64 = rows
             .iter()
@@ -256,7 +254,7 @@ pub fn output_stats(
         tss += tk;
         rss += rk;
         prss += pk;
-        let name = rel.output_name(k);
+        let name = rel.card().outputs[k].name.to_string();
         let rec = |what: &str, unit: &str, value: f64, published: f64| DerivedRecord {
             name: format!("{name}: {what}"),
             unit: unit.to_string(),
@@ -289,7 +287,7 @@ pub fn output_stats(
 /// Notes for free parameters whose refit value lies outside their bounds (the active set
 /// missed one; should not happen, but a silent violation would be worse than a note).
 pub fn violations(rel: &dyn Relation, values: &[f64], free: &[bool]) -> Vec<String> {
-    let specs = rel.parameters();
+    let specs = rel.card().parameters;
     (0..values.len())
         .filter(|&i| free[i])
         .filter_map(|i| {

@@ -21,7 +21,7 @@ use super::inference::{
 };
 use super::pipeline::Prepared;
 use crate::fit::forms::{Fitting, NormalEquations};
-use crate::relations::{Observation, ParamKind, Relation};
+use crate::relations::{Inputs, Observation, ParamKind, Relation};
 use nalgebra::{DMatrix, DVector};
 
 /// Most basis columns a relation may have (the fixed-size row buffers).
@@ -43,7 +43,7 @@ impl Layout {
     /// The layout of `rel` for the free mask `free` on rows from `n_subj` subjects.
     pub fn new(rel: &dyn Relation, free: Vec<bool>, n_subj: usize) -> Layout {
         let nb = rel.basis_len(&free);
-        let subj_col = if n_subj >= 2 && rel.subject_effect().is_some() {
+        let subj_col = if n_subj >= 2 && rel.card().subject_effect.is_some() {
             rel.subject_column(&free)
         } else {
             None
@@ -57,7 +57,7 @@ impl Layout {
     /// The basis row of `x` at `p`: the global columns into `g` (length [`Layout::m`]), and
     /// `(offset, z)` with `z` the per-subject column's value (0 without one).
     #[inline]
-    pub fn row(&self, rel: &dyn Relation, p: &[f64], x: &[f64], g: &mut [f64]) -> (f64, f64) {
+    pub fn row(&self, rel: &dyn Relation, p: &[f64], x: &Inputs, g: &mut [f64]) -> (f64, f64) {
         let mut phi = [0.0; MAX_BASIS];
         let off = rel.basis(p, &self.free, x, &mut phi[..self.nb]);
         match self.subj_col {
@@ -96,7 +96,7 @@ impl Layout {
         let out = &lm.map * coef + &lm.shift;
         let mut q = p.to_vec();
         let mut j = 0;
-        for (i, s) in rel.parameters().iter().enumerate() {
+        for (i, s) in rel.card().parameters.iter().enumerate() {
             if s.kind == ParamKind::Linear {
                 q[i] = out[j];
                 j += 1;
@@ -439,7 +439,7 @@ impl DesignFit {
         let mut residuals = vec![0.0; n];
         let mut leverage = vec![0.0; n];
         let mut scores = vec![DVector::<f64>::zeros(m); n_subj];
-        let n_out = rel.outputs();
+        let n_out = rel.card().outputs.len();
         let mut outputs = vec![(0.0, 0usize, DMatrix::<f64>::zeros(m, m)); n_out];
         let (mut rss, mut sum_log_w) = (0.0, 0.0);
         let mut g = [0.0; MAX_BASIS];
@@ -475,7 +475,7 @@ impl DesignFit {
             }
             scores[s].axpy(w * e, &xt, 1.0);
             if n_out > 1 {
-                let k = rel.output_of(&o.x);
+                let k = o.x.output;
                 let out = &mut outputs[k];
                 out.0 += w * e * e;
                 out.1 += 1;

@@ -56,7 +56,7 @@ use super::stats::{
 use super::FitError;
 use crate::fit::forms::Fitting;
 use crate::ingest::trials::TrialsTable;
-use crate::relations::{ParamKind, Relation};
+use crate::relations::{Fitted, Inputs, ParamKind, Relation};
 use profile::{
     confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, Profiler,
     SortedRows, Source, Subset,
@@ -154,9 +154,9 @@ pub struct FitOutcome {
     /// The statistics (written to `fits/`).
     pub record: FitRecord,
     /// The relation with the refitted coefficients.
-    pub refit: Box<dyn Relation>,
+    pub refit: Fitted,
     /// The relation with the published coefficients.
-    pub published: Box<dyn Relation>,
+    pub published: Fitted,
     /// The rows used.
     pub prepared: Prepared,
     /// Fitted values (each row with its subject's level).
@@ -180,18 +180,18 @@ pub fn fit_relation(
     opts: &FitOptions,
 ) -> Result<FitOutcome, FitError> {
     opts.validate(tables)?;
-    let id = rel.id().to_string();
+    let id = rel.card().id.to_string();
     let prep = prepare(rel, tables, opts.weights.as_deref());
     let n = prep.obs.len();
-    let specs = rel.parameters();
-    let published = rel.values().to_vec();
+    let specs = rel.card().parameters;
+    let published = rel.card().published_values();
     let n_subj = prep.subjects.len();
     let method = opts.se_method(&id, n_subj)?;
     // Rows sorted once by the breakpoint key, with prefix sums: every profile evaluation
     // below (search, F-test, confidence sets, folds, bootstrap) then costs O(p³), not a pass.
     // The tree over all rows serves fits without per-subject columns; with them, every
     // evaluation (and fold, and replicate) sums subjects' trees.
-    let with_all = !(rel.subject_effect().is_some() && n_subj >= 2);
+    let with_all = !(rel.card().subject_effect.is_some() && n_subj >= 2);
     let sorted = rel
         .sorted_profile()
         .map(|form| SortedRows::new(form, &prep, with_all));
@@ -238,7 +238,7 @@ pub fn fit_relation(
         }
         return Err(FitError::TooFew {
             relation: format!("{id}{why}"),
-            what: format!("rows of gait `{}`", rel.gait()),
+            what: format!("rows of gait `{}`", rel.card().gait),
             have: n,
             need: n_params_max + 2,
         });
@@ -357,7 +357,7 @@ pub fn fit_relation(
     if n < k + 2 {
         return Err(FitError::TooFew {
             relation: id.clone(),
-            what: format!("rows of gait `{}`", rel.gait()),
+            what: format!("rows of gait `{}`", rel.card().gait),
             have: n,
             need: k + 2,
         });
@@ -387,7 +387,7 @@ pub fn fit_relation(
     let obs_y: Vec<f64> = prep.obs.iter().map(|o| o.y).collect();
     let wopt = weighted.then_some(prep.weights.as_slice());
     let r2c = r2_centred(&obs_y, rss, wopt);
-    let (r2, r2_def) = if rel.has_intercept() {
+    let (r2, r2_def) = if rel.card().has_intercept {
         (r2c, "centred: 1 − RSS/Σ(y − ȳ)²".to_string())
     } else {
         (
@@ -396,7 +396,7 @@ pub fn fit_relation(
                 .to_string(),
         )
     };
-    let adj_r2 = if rel.has_intercept() {
+    let adj_r2 = if rel.card().has_intercept {
         1.0 - (1.0 - r2) * (n as f64 - 1.0) / df
     } else {
         1.0 - (1.0 - r2) * n as f64 / df
@@ -454,7 +454,7 @@ pub fn fit_relation(
                 c
             })
             .collect();
-        let mean_at = |q: &[f64], c: &DVector<f64>, x: &[f64]| {
+        let mean_at = |q: &[f64], c: &DVector<f64>, x: &Inputs| {
             let mut phi = [0.0; MAX_BASIS];
             let off = rel.basis(q, &lay.free, x, &mut phi[..lay.nb]);
             off + (0..lay.nb).map(|j| phi[j] * c[j]).sum::<f64>()
@@ -706,7 +706,7 @@ pub fn fit_relation(
         coefs.push(rec);
     }
     let _ = n_lin;
-    if let (Some(e), Some(_)) = (rel.subject_effect(), lay.subj_col) {
+    if let (Some(e), Some(_)) = (rel.card().subject_effect, lay.subj_col) {
         // A subject's own slope is informed by that subject's rows only: no cluster-robust
         // standard error exists for it; its standard error is the iid one within the subject,
         // conditional on the subjects fitted.
@@ -763,10 +763,10 @@ pub fn fit_relation(
              predicted with {} = 0",
             e.name, e.on, e.on, e.name
         ));
-    } else if rel.subject_effect().is_some() {
+    } else if rel.card().subject_effect.is_some() {
         notes.push(format!(
             "one subject only: no per-subject {} fitted",
-            rel.subject_effect().map_or("", |e| e.name)
+            rel.card().subject_effect.map_or("", |e| e.name)
         ));
     }
 
@@ -867,7 +867,7 @@ pub fn fit_relation(
         .zip(&prep.weights)
         .map(|(e, w)| w * e * e)
         .sum();
-    let pub_r2 = if rel.has_intercept() {
+    let pub_r2 = if rel.card().has_intercept {
         r2_centred(&obs_y, pub_rss, wopt)
     } else {
         r2_uncentred(&obs_y, pub_rss, wopt)
@@ -978,19 +978,19 @@ pub fn fit_relation(
     }
 
     let mut units = BTreeMap::new();
-    let resp = rel.response();
+    let resp = rel.card().response;
     units.insert(resp.symbol.to_string(), resp.unit.to_string());
-    for v in rel.inputs() {
+    for v in rel.card().inputs {
         units.insert(v.symbol.to_string(), v.unit.to_string());
     }
     for s in specs {
         units.insert(s.name.to_string(), s.unit.to_string());
     }
-    if let Some(e) = rel.subject_effect() {
+    if let Some(e) = rel.card().subject_effect {
         units.insert(e.name.to_string(), e.unit.to_string());
     }
     let valid_range = rel
-        .inputs()
+        .card().inputs
         .iter()
         .enumerate()
         .map(|(j, v)| {
@@ -1041,7 +1041,7 @@ pub fn fit_relation(
             crate::ingest::trials::sha256_hex(joined.as_bytes()),
         )
     };
-    let c = rel.citation();
+    let c = rel.card().citation;
     let mut levels = BTreeMap::new();
     for c in &coefs {
         if let Some(s) = c
@@ -1064,9 +1064,9 @@ pub fn fit_relation(
     };
     let record = FitRecord {
         relation: id.clone(),
-        title: rel.title().to_string(),
+        title: rel.card().title.to_string(),
         citation: format!("{}, {}", c.paper, c.equation),
-        equation: rel.equation().to_string(),
+        equation: rel.card().equation.to_string(),
         units,
         n,
         n_subjects: n_subj,
@@ -1108,15 +1108,20 @@ pub fn fit_relation(
         notes,
     };
     // The refit knows the range it was fitted on (predictions beyond it hold the boundary).
-    let mut refit = rel.with_values(&values, levels);
     let mut fitted_range = crate::relations::FittedRange::default();
     for (b, g) in fitted_range.bounds.iter_mut().zip(&record.valid_range) {
         *b = (g.lo <= g.hi).then_some([g.lo, g.hi]);
     }
-    refit.set_fitted_range(fitted_range);
+    let registered = || {
+        crate::relations::by_id(&id).map_err(|e| FitError::InvalidInput {
+            relation: id.clone(),
+            message: e.to_string(),
+        })
+    };
+    let refit = Fitted::new(registered()?, values.clone(), levels, fitted_range);
     Ok(FitOutcome {
         refit,
-        published: rel.with_values(&published, BTreeMap::new()),
+        published: Fitted::published(registered()?),
         record,
         prepared: prep,
         fitted,
@@ -1149,14 +1154,14 @@ pub fn fit_all(
 ) -> FitRun {
     let mut run = FitRun::default();
     for rel in relations {
-        progress(rel.id());
+        progress(rel.card().id);
         let has_gait = tables
             .iter()
-            .any(|t| t.gait.iter().any(|g| *g == Some(rel.gait())));
+            .any(|t| t.gait.iter().any(|g| *g == Some(rel.card().gait)));
         if !has_gait && skip_missing_gait {
             run.skipped.push((
-                rel.id().to_string(),
-                format!("no rows with gait = {}", rel.gait()),
+                rel.card().id.to_string(),
+                format!("no rows with gait = {}", rel.card().gait),
             ));
             continue;
         }
@@ -1165,8 +1170,8 @@ pub fn fit_all(
             // Rows of the gait but none usable (e.g. no μ columns for kb-mu): nothing to fit.
             Err(e @ FitError::TooFew { have: 0, .. }) if skip_missing_gait => run
                 .skipped
-                .push((rel.id().to_string(), format!("no usable rows: {e}"))),
-            Err(e) => run.failures.push((rel.id().to_string(), e.to_string())),
+                .push((rel.card().id.to_string(), format!("no usable rows: {e}"))),
+            Err(e) => run.failures.push((rel.card().id.to_string(), e.to_string())),
         }
     }
     run

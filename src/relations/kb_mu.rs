@@ -14,7 +14,7 @@
 //! are held: with a free intercept μᵢ* the pair (sl*, μᵢ*) is not identifiable.
 //!
 //! **Several outputs.** One trials row (one step) gives up to four observations, one per μ
-//! ([`Relation::outputs`]): the observation's inputs are `x` and the μ index `i` (0…3). The
+//! ([`Card::outputs`]): the observation's input is `x`, its [`Inputs::output`] the μ index (0…3). The
 //! model is linear in α and μ* (a separate line per μ), so the generic linear machinery applies;
 //! r² is pooled with each μ centred on its own mean, and per-μ n, r², rmse and leave-one-out
 //! rmse are reported as derived quantities (see `fit::constrained`).
@@ -42,12 +42,9 @@
 //! // At the prototype's own step length and leg length every μ is the prototype's μ*.
 //! let x = r.argument(r.sl_star(), r.ll_star());
 //! assert!((r.mu(2, x) - r.mu_star()[2]).abs() < 1e-15);
-//! assert_eq!(r.outputs(), 4);
+//! assert_eq!(r.card().outputs.len(), 4);
 //! ```
-use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
-    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
-};
+use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::Quantity;
@@ -71,7 +68,7 @@ pub const MU_QUANTITIES: [Quantity; 4] = [
     Quantity::FootAngleTo,
     Quantity::MetaAngleTo,
 ];
-/// Coefficient names, in [`Relation::parameters`] order.
+/// Coefficient names, in [`Card::parameters`] order.
 pub const NAMES: [&str; 10] = [
     "alpha1", "alpha2", "alpha3", "alpha4", "mu1_star", "mu2_star", "mu3_star", "mu4_star",
     "sl_star", "ll_star",
@@ -80,13 +77,24 @@ pub const NAMES: [&str; 10] = [
 pub const SL_STAR: usize = 8;
 /// Index of ll(S*) among the parameters.
 pub const LL_STAR: usize = 9;
-/// Names of the four outputs.
-const OUTPUT_NAMES: [&str; 4] = ["mu1", "mu2", "mu3", "mu4"];
-const OUTPUT_LABELS: [&str; 4] = [
-    "μ1: knee flexion at heel strike",
-    "μ2: foot angle at heel strike",
-    "μ3: foot angle at toe off",
-    "μ4: meta angle at toe off",
+/// The four outputs, μ₁…μ₄ (an observation's [`Inputs::output`] indexes them).
+const OUTPUTS: &[Output] = &[
+    Output {
+        name: "mu1",
+        label: "μ1: knee flexion at heel strike",
+    },
+    Output {
+        name: "mu2",
+        label: "μ2: foot angle at heel strike",
+    },
+    Output {
+        name: "mu3",
+        label: "μ3: foot angle at toe off",
+    },
+    Output {
+        name: "mu4",
+        label: "μ4: meta angle at toe off",
+    },
 ];
 
 const INPUTS: &[Variable] = &[
@@ -94,11 +102,6 @@ const INPUTS: &[Variable] = &[
         symbol: "x",
         unit: "m",
         name: "leg-length-normalized step length sl·ll(S*)/ll(S)",
-    },
-    Variable {
-        symbol: "i",
-        unit: "-",
-        name: "μ-function index (0…3 for μ1…μ4)",
     },
 ];
 
@@ -280,57 +283,55 @@ impl KbMu {
     }
 }
 
-impl Relation for KbMu {
-    fn id(&self) -> &'static str {
-        ID
-    }
-    fn title(&self) -> &'static str {
-        "Ko–Badler μ-functions: joint angles at heel strike and toe off vs step length"
-    }
-    fn citation(&self) -> Citation {
-        Citation {
+/// What the relation is (built once: its parameters carry the bundled prototype's values).
+fn card() -> &'static Card {
+    static C: OnceLock<Card> = OnceLock::new();
+    C.get_or_init(|| Card {
+        id: ID,
+        title: "Ko–Badler μ-functions: joint angles at heel strike and toe off vs step length",
+        citation: Citation {
             paper: "Ko & Badler (1993), Straight line walking animation based on kinematic \
                     generalization that preserves the original characteristics",
             equation: "appendix A, eqs. 21–24 (argument corrected to sl·ll(S*)/ll(S))",
-        }
-    }
-    fn equation(&self) -> &'static str {
-        "mu1 = -alpha1 (x - sl*) + mu1*; mu_i = alpha_i (x - sl*) + mu_i* (i = 2..4); \
-         x = sl ll(S*)/ll(S)"
-    }
-    fn response(&self) -> Variable {
-        Variable {
+        },
+        equation: "mu1 = -alpha1 (x - sl*) + mu1*; mu_i = alpha_i (x - sl*) + mu_i* (i = 2..4); \
+                   x = sl ll(S*)/ll(S)",
+        response: Variable {
             symbol: "mu",
             unit: "rad",
             name: "μ angle (knee at heel strike, foot at heel strike, foot at toe off, meta at toe off)",
-        }
-    }
-    fn inputs(&self) -> &'static [Variable] {
-        INPUTS
-    }
-    fn gait(&self) -> Gait {
-        Gait::Walk
-    }
-    fn needs(&self) -> &'static [Quantity] {
-        &[
+        },
+        inputs: INPUTS,
+        outputs: OUTPUTS,
+        gait: Gait::Walk,
+        needs: &[
             Quantity::StepLength,
             Quantity::LegLength,
             Quantity::KneeAngleHs,
             Quantity::FootAngleHs,
             Quantity::FootAngleTo,
             Quantity::MetaAngleTo,
-        ]
+        ],
+        parameters: params(),
+        subject_effect: None,
+        has_intercept: true,
+        domain: Domain {
+            input: "x",
+            lo: 0.0,
+            hi: f64::INFINITY,
+            note: "the paper states no range; μ₂…μ₄ must stay positive (they scale F₁, F₂, M)",
+        },
+    })
+}
+
+impl Relation for KbMu {
+    fn card(&self) -> &'static Card {
+        card()
     }
-    /// The first μ of the row ([`Relation::observe_output`] gives the others).
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        self.observe_output(row, 0)
-    }
-    fn outputs(&self) -> usize {
-        4
-    }
-    fn observe_output(&self, row: &FieldValues, k: usize) -> Result<Observation, Rejection> {
-        let q = MU_QUANTITIES[k.min(3)];
-        let y = required(row, q)?;
+    /// Observation `output` (μ₁…μ₄ for 0…3) of the row.
+    fn observe(&self, row: &FieldValues, output: usize) -> Result<Observation, Rejection> {
+        let k = output.min(3);
+        let y = required(row, MU_QUANTITIES[k])?;
         let sl = required(row, Quantity::StepLength)?;
         let ll = required(row, Quantity::LegLength)?;
         if !(ll > 0.0 && sl > 0.0) {
@@ -339,24 +340,9 @@ impl Relation for KbMu {
             )));
         }
         Ok(Observation {
-            x: [self.argument(sl, ll), k as f64, 0.0, 0.0],
+            x: Inputs::new(&[self.argument(sl, ll)]).of_output(k),
             y,
         })
-    }
-    fn output_of(&self, x: &[f64]) -> usize {
-        (x[1].max(0.0) as usize).min(3)
-    }
-    fn output_name(&self, k: usize) -> String {
-        OUTPUT_NAMES[k.min(3)].to_string()
-    }
-    fn output_label(&self, k: usize) -> String {
-        OUTPUT_LABELS[k.min(3)].to_string()
-    }
-    fn select_output(&self, x: &mut [f64], k: usize) {
-        x[1] = k as f64;
-    }
-    fn parameters(&self) -> &'static [ParameterSpec] {
-        params()
     }
     fn bounds(&self, i: usize) -> (f64, f64) {
         match i {
@@ -365,44 +351,14 @@ impl Relation for KbMu {
             _ => (f64::NEG_INFINITY, f64::INFINITY),
         }
     }
-    fn has_intercept(&self) -> bool {
-        true
-    }
-    fn domain(&self) -> Domain {
-        Domain {
-            input: "x",
-            lo: 0.0,
-            hi: f64::INFINITY,
-            note: "the paper states no range; μ₂…μ₄ must stay positive (they scale F₁, F₂, M)",
-        }
-    }
-    fn values(&self) -> &[f64] {
-        &self.values
-    }
-    fn fitted_range(&self) -> FittedRange {
-        self.range
-    }
-    fn set_fitted_range(&mut self, range: FittedRange) {
-        self.range = range;
-    }
-    fn subject_levels(&self) -> &BTreeMap<String, f64> {
-        &self.levels
-    }
-    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]) {
+    fn raw_basis(&self, p: &[f64], x: &Inputs, g: &mut [f64]) {
         g.iter_mut().for_each(|v| *v = 0.0);
-        let i = self.output_of(x);
+        let i = x.output.min(3);
         g[i] = sign(i) * (x[0] - p[SL_STAR]);
         g[4 + i] = 1.0;
     }
-    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    fn gradient(&self, p: &[f64], x: &Inputs) -> Option<Vec<f64>> {
         Some(linear_gradient(self, p, x))
-    }
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
-        Box::new(KbMu {
-            values: values.to_vec(),
-            levels,
-            range: FittedRange::default(),
-        })
     }
 }
 
@@ -437,9 +393,9 @@ mod tests {
         let mut r = KbMu::published();
         r.values[..8].copy_from_slice(&[0.1, 0.5, 0.9, 1.3, 0.05, 0.4, 1.2, 0.9]);
         for i in 0..4 {
-            let x = [0.63, i as f64, 0.0, 0.0];
+            let x = Inputs::new(&[0.63]).of_output(i);
             let want = sign(i) * r.values[i] * (0.63 - r.sl_star()) + r.values[4 + i];
-            assert!((r.predict(&x) - want).abs() < 1e-15);
+            assert!((r.predict_with(&r.values, 0.0, &x) - want).abs() < 1e-15);
             assert!((r.mu(i, 0.63) - want).abs() < 1e-15);
         }
     }

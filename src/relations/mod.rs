@@ -9,10 +9,19 @@
 //! | `walk-tds-sf` | [`WalkTdsSf`] | walking 1989, §3 (t_ds formula) |
 //! | `kb-mu` | [`KbMu`] (four outputs, bounded) | Ko & Badler 1993, appendix A, eqs. 21–24 |
 //!
+//! # Specification and fitted values
+//! A [`Relation`] is the specification only: its [`Card`] (id, formula, variables, outputs,
+//! parameters with their published values, domain), `observe` (a row → an [`Observation`] per
+//! output) and the formula (`raw_basis`, `predict_with`). Coefficient values live in a
+//! [`Fitted`] (values, per-subject levels, fitted range, `predict_checked`): published
+//! ([`Fitted::published`]), refitted by `gaitfit::fit::pipeline`, or read by [`load_fit`]. How
+//! the fit treats the parameters (plan, basis, breakpoint profiles) is `gaitfit::fit::forms`;
+//! the relations import nothing from fit or the generators.
+//!
 //! # Using a relation (generators)
 //! Every type has `published()` (the papers' coefficients), typed evaluation methods in the
-//! papers' units (e.g. [`RunSlV::step_length`]), and `from_fit_file("fits/<id>.json")` to use
-//! coefficients refitted by `gaitfit fit`. [`load_fit`] does the same behind the trait.
+//! papers' units (e.g. [`RunSlV::step_length`]) at the coefficients it carries, and
+//! `from_fit_file("fits/<id>.json")` to use coefficients refitted by `gaitfit fit`.
 //!
 //! ```
 //! use gaitfit::relations::{RunSlV, RunTflightSf, WalkSlSf, WalkTdsSf};
@@ -29,25 +38,37 @@
 //! ```
 //!
 //! # Adding a relation
-//! Implement [`Relation`] in one new file: metadata, `observe` (which [`Quantity`]s of a row it
-//! needs, converted to the papers' units), `parameters`, and `raw_basis` — the model must be
-//! linear in its [`ParamKind::Linear`] parameters once the [`ParamKind::Breakpoint`] ones are
-//! fixed (true of all the papers' relations); `predict` then comes for free. Register it in
-//! [`registry`]. The generic fit routine (`gaitfit::fit::pipeline`) produces the statistics,
-//! tables and plots without further code. A relation whose breakpoints are to be profiled (not
-//! held) also gets a fit form in `gaitfit::fit::forms` (how the fit treats its parameters: plan,
-//! basis, sorted profile); the relations themselves import nothing from fit or the generators.
-pub mod kb_mu;
-pub mod run_sl_v;
-pub mod run_tflight_sf;
-pub mod walk_sl_sf;
-pub mod walk_tds_sf;
+//! One new file implementing [`Relation`] (its [`Card`], `observe` converting a row's
+//! [`Quantity`]s to the papers' units, and `raw_basis` — the model must be linear in its
+//! [`ParamKind::Linear`] parameters once the [`ParamKind::Breakpoint`] ones are fixed, true of
+//! all the papers' relations), plus one line in the `relations!` list below (module, type,
+//! constructor): the registry, the CLI's ids and help and the generic fit routine
+//! (`gaitfit::fit::pipeline`: statistics, tables, plots) follow from it. Breakpoints are held at
+//! their published values unless the relation also gets a fit form in `gaitfit::fit::forms`
+//! (how they are profiled).
+/// Declares the relation modules and the registry in one list: each line is a module, its type
+/// (re-exported here) and the relations it registers, in report order.
+macro_rules! relations {
+    ($($(#[$doc:meta])* $module:ident :: $ty:ident => [$($make:expr),+ $(,)?]),+ $(,)?) => {
+        $($(#[$doc])* pub mod $module; pub use $module::$ty;)+
 
-pub use kb_mu::KbMu;
-pub use run_sl_v::RunSlV;
-pub use run_tflight_sf::{Continuity, RunTflightSf};
-pub use walk_sl_sf::WalkSlSf;
-pub use walk_tds_sf::WalkTdsSf;
+        /// Every relation gaitfit knows, in report order: the single list the fit, the CLI
+        /// (ids and help) and the reports read.
+        pub fn registry() -> Vec<Box<dyn Relation>> {
+            vec![$($(Box::new($make)),+),+]
+        }
+    };
+}
+
+relations! {
+    run_sl_v::RunSlV => [RunSlV::published()],
+    run_tflight_sf::RunTflightSf => [RunTflightSf::published(), RunTflightSf::published_continuous()],
+    walk_sl_sf::WalkSlSf => [WalkSlSf::published()],
+    walk_tds_sf::WalkTdsSf => [WalkTdsSf::published()],
+    kb_mu::KbMu => [KbMu::published()],
+}
+
+pub use run_tflight_sf::Continuity;
 
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
@@ -174,13 +195,104 @@ pub struct Domain {
     pub note: &'static str,
 }
 
+/// The inputs of one prediction or observation, in the papers' units, with the output they
+/// belong to: `values` in [`Card::inputs`] order (unused slots 0), `output` the index of the
+/// relation's output ([`Card::outputs`]; 0 for single-output relations — `kb-mu` has four, one
+/// per μ-function). Dereferences to the input values (`x[0]` is the first input).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Inputs {
+    /// Input values, in [`Card::inputs`] order; unused slots are 0.
+    pub values: [f64; MAX_INPUTS],
+    /// Which output of the relation (index into [`Card::outputs`]).
+    pub output: usize,
+}
+
+impl Inputs {
+    /// Inputs of output 0 (single-output relations): the first `x.len()` values (≤
+    /// [`MAX_INPUTS`]), the rest 0.
+    pub fn new(x: &[f64]) -> Inputs {
+        let mut values = [0.0; MAX_INPUTS];
+        for (v, &s) in values.iter_mut().zip(x) {
+            *v = s;
+        }
+        Inputs { values, output: 0 }
+    }
+    /// The same inputs for output `k`.
+    pub fn of_output(self, k: usize) -> Inputs {
+        Inputs { output: k, ..self }
+    }
+}
+
+impl std::ops::Deref for Inputs {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        &self.values
+    }
+}
+
 /// One row reduced to what a relation uses: inputs and response in the papers' units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observation {
-    /// Inputs, in the order of [`Relation::inputs`]; unused slots are 0.
-    pub x: [f64; MAX_INPUTS],
+    /// Inputs (with the output they belong to).
+    pub x: Inputs,
     /// Response.
     pub y: f64,
+}
+
+/// One output of a relation: a row gives one observation per output (`kb-mu`: one per μ).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output {
+    /// Name (for reports: per-output statistics are named after it).
+    pub name: &'static str,
+    /// What it is, for a plot panel's label.
+    pub label: &'static str,
+}
+
+/// What a relation is, as its paper states it: identity, formula, variables, parameters with
+/// their published values, domain. Static data; [`Relation::card`] gives it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Card {
+    /// The relation id (`run-sl-v`, …): interface, used for file names.
+    pub id: &'static str,
+    /// One-line title.
+    pub title: &'static str,
+    /// The paper and equation.
+    pub citation: Citation,
+    /// The formula in the papers' units, as text.
+    pub equation: &'static str,
+    /// The response variable.
+    pub response: Variable,
+    /// The input variables (the first is the one plots use as abscissa).
+    pub inputs: &'static [Variable],
+    /// The outputs a row gives (at least one).
+    pub outputs: &'static [Output],
+    /// The gait whose rows this relation uses.
+    pub gait: Gait,
+    /// The row quantities it needs.
+    pub needs: &'static [Quantity],
+    /// The global parameters (coefficient vectors `p` hold them in this order).
+    pub parameters: &'static [ParameterSpec],
+    /// The per-subject effect, if the relation has one.
+    pub subject_effect: Option<SubjectEffect>,
+    /// True when the model has an intercept (r² is then centred; otherwise uncentred, as NIST
+    /// defines it for regressions through the origin).
+    pub has_intercept: bool,
+    /// The input domain of the published relation.
+    pub domain: Domain,
+}
+
+impl Card {
+    /// Number of linear parameters.
+    pub fn n_linear(&self) -> usize {
+        self.parameters
+            .iter()
+            .filter(|s| s.kind == ParamKind::Linear)
+            .count()
+    }
+    /// The published coefficients, in [`Card::parameters`] order.
+    pub fn published_values(&self) -> Vec<f64> {
+        self.parameters.iter().map(|s| s.published).collect()
+    }
 }
 
 /// Why a row cannot be used by a relation.
@@ -193,7 +305,7 @@ pub enum Rejection {
 }
 
 /// The value of quantity `q` in `row`, or the rejection naming it: what every relation's
-/// [`Relation::observe`] asks of a row for each quantity it [`Relation::needs`].
+/// [`Relation::observe`] asks of a row for each quantity it needs ([`Card::needs`]).
 fn required(row: &FieldValues, q: Quantity) -> Result<f64, Rejection> {
     row.get(q).ok_or(Rejection::Missing(q))
 }
@@ -207,67 +319,37 @@ impl std::fmt::Display for Rejection {
     }
 }
 
-/// A published gait relation (see the module docs).
+/// A published gait relation, the specification (see the module docs): what the paper states
+/// ([`Relation::card`]), how a row is observed, and the formula. Coefficient values live
+/// elsewhere: in a [`Fitted`] (published, or read from a fits file) or in the typed structs the
+/// generators use; how the fit treats the parameters is `gaitfit::fit::forms`.
 ///
-/// Coefficient vectors (`p`) hold the global parameters in [`Relation::parameters`] order;
+/// Coefficient vectors (`p`) hold the global parameters in [`Card::parameters`] order;
 /// per-subject effects are passed separately as an additive offset.
 pub trait Relation: Send + Sync + std::fmt::Debug {
-    /// The relation id (`run-sl-v`, …): interface, used for file names.
-    fn id(&self) -> &'static str;
-    /// One-line title.
-    fn title(&self) -> &'static str;
-    /// The paper and equation.
-    fn citation(&self) -> Citation;
-    /// The formula in the papers' units, as text.
-    fn equation(&self) -> &'static str;
-    /// The response variable.
-    fn response(&self) -> Variable;
-    /// The input variables (the first is the one plots use as abscissa).
-    fn inputs(&self) -> &'static [Variable];
-    /// The gait whose rows this relation uses.
-    fn gait(&self) -> Gait;
-    /// The row quantities it needs.
-    fn needs(&self) -> &'static [Quantity];
-    /// Reduces a row (SI) to inputs and response in the papers' units.
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection>;
-    /// The global parameters.
-    fn parameters(&self) -> &'static [ParameterSpec];
-    /// The per-subject effect, if the relation has one.
-    fn subject_effect(&self) -> Option<SubjectEffect> {
-        None
-    }
-    /// True when the model has an intercept (r² is then centred; otherwise uncentred, as NIST
-    /// defines it for regressions through the origin).
-    fn has_intercept(&self) -> bool;
-    /// The input domain of the published relation.
-    fn domain(&self) -> Domain;
-    /// Current coefficient values (published, or loaded from a fit), in `parameters()` order.
-    fn values(&self) -> &[f64];
-    /// Per-subject effects of the loaded fit (empty for published coefficients).
-    fn subject_levels(&self) -> &BTreeMap<String, f64>;
+    /// What the relation is (static).
+    fn card(&self) -> &'static Card;
+
+    /// Reduces a row (SI) to the observation of output `output` (< `card().outputs.len()`),
+    /// inputs and response in the papers' units. A row is rejected only when none of its
+    /// outputs is usable.
+    fn observe(&self, row: &FieldValues, output: usize) -> Result<Observation, Rejection>;
 
     /// The derivatives of the prediction with respect to each [`ParamKind::Linear`] parameter
     /// (in order), at the breakpoints in `p`: the model is `Σ_j p_lin[j] · g[j]`.
-    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]);
-
-    /// Number of linear parameters.
-    fn n_linear(&self) -> usize {
-        self.parameters()
-            .iter()
-            .filter(|s| s.kind == ParamKind::Linear)
-            .count()
-    }
+    fn raw_basis(&self, p: &[f64], x: &Inputs, g: &mut [f64]);
 
     /// Prediction with coefficients `p` and a per-subject offset on the
     /// [`SubjectEffect::on`] parameter.
-    fn predict_with(&self, p: &[f64], subject_offset: f64, x: &[f64]) -> f64 {
+    fn predict_with(&self, p: &[f64], subject_offset: f64, x: &Inputs) -> f64 {
+        let card = self.card();
         let mut g = [0.0; 16];
-        let nl = self.n_linear();
+        let nl = card.n_linear();
         self.raw_basis(p, x, &mut g[..nl]);
-        let on = self.subject_effect().map(|e| e.on);
+        let on = card.subject_effect.map(|e| e.on);
         let mut y = 0.0;
         let mut j = 0;
-        for (i, s) in self.parameters().iter().enumerate() {
+        for (i, s) in card.parameters.iter().enumerate() {
             if s.kind == ParamKind::Linear {
                 let mut c = p[i];
                 if Some(s.name) == on {
@@ -280,92 +362,16 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
         y
     }
 
-    /// Prediction with the current coefficients for an average subject (offset 0).
-    fn predict(&self, x: &[f64]) -> f64 {
-        self.predict_with(self.values(), 0.0, x)
-    }
-
-    /// The input range the coefficients were fitted on (read from the fits file; empty for the
-    /// published coefficients and for relations built in memory).
-    fn fitted_range(&self) -> FittedRange {
-        FittedRange::default()
-    }
-
-    /// Sets the fitted input range (relations that keep none ignore it).
-    fn set_fitted_range(&mut self, _range: FittedRange) {}
-
-    /// [`Relation::predict`] with the rule of [`FittedRange`]: whether `x` lies inside the
-    /// fitted range, and outside it the boundary value held (inputs clamped to `[lo, hi]`).
-    fn predict_checked(&self, x: &[f64]) -> Prediction {
-        let r = self.fitted_range();
-        let at = r.hold(x);
-        Prediction {
-            value: self.predict(&at),
-            inside: r.contains(x),
-            at,
-        }
-    }
-
     /// Analytic gradient of the prediction with respect to all global parameters, when
-    /// available. The default gives the linear part exactly and leaves breakpoints to the
-    /// caller (`None`).
-    fn gradient(&self, _p: &[f64], _x: &[f64]) -> Option<Vec<f64>> {
+    /// available (`None`: the caller differentiates numerically).
+    fn gradient(&self, _p: &[f64], _x: &Inputs) -> Option<Vec<f64>> {
         None
     }
-
-    /// A copy of this relation with other coefficient values (and per-subject levels).
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation>;
 
     /// Derived quantities worth reporting for a coefficient vector (name, value, unit), e.g.
     /// the jump of the flight-time curve at `k1`.
     fn derived(&self, _p: &[f64]) -> Vec<(String, f64, &'static str)> {
         Vec::new()
-    }
-
-    /// The published coefficients, in `parameters()` order.
-    fn published_values(&self) -> Vec<f64> {
-        self.parameters().iter().map(|s| s.published).collect()
-    }
-
-    /// The index of parameter `name`.
-    fn index_of(&self, name: &str) -> Option<usize> {
-        self.parameters().iter().position(|s| s.name == name)
-    }
-
-    /// Number of observations one row can give (1; `kb-mu` gives one per μ-function). The
-    /// pipeline then pools them, centres r² within each output and reports per-output
-    /// statistics.
-    fn outputs(&self) -> usize {
-        1
-    }
-
-    /// Reduces a row to its `k`-th observation (`k <` [`Relation::outputs`]); by default
-    /// [`Relation::observe`]. A row is rejected only when none of its outputs is usable.
-    fn observe_output(&self, row: &FieldValues, k: usize) -> Result<Observation, Rejection> {
-        let _ = k;
-        self.observe(row)
-    }
-
-    /// Which output an observation's inputs belong to (0 for single-output relations).
-    fn output_of(&self, x: &[f64]) -> usize {
-        let _ = x;
-        0
-    }
-
-    /// Name of output `k` (for reports).
-    fn output_name(&self, k: usize) -> String {
-        let _ = k;
-        self.response().symbol.to_string()
-    }
-
-    /// What output `k` is, for a plot panel's label; by default its name.
-    fn output_label(&self, k: usize) -> String {
-        self.output_name(k)
-    }
-
-    /// Sets the inputs that select output `k` (for plotting one curve per output).
-    fn select_output(&self, x: &mut [f64], k: usize) {
-        let _ = (x, k);
     }
 
     /// The allowed range of parameter `i` (unbounded by default). Where a bound is finite the
@@ -376,12 +382,95 @@ pub trait Relation: Send + Sync + std::fmt::Debug {
     }
 }
 
+/// A relation with coefficient values: published, refitted by the pipeline, or read from a
+/// fits file (with the per-subject levels and the fitted input range).
+#[derive(Debug)]
+pub struct Fitted {
+    relation: Box<dyn Relation>,
+    values: Vec<f64>,
+    levels: BTreeMap<String, f64>,
+    range: FittedRange,
+}
+
+impl Fitted {
+    /// `relation` with coefficient `values` (in [`Card::parameters`] order), per-subject
+    /// `levels` and the fitted input `range`.
+    pub fn new(
+        relation: Box<dyn Relation>,
+        values: Vec<f64>,
+        levels: BTreeMap<String, f64>,
+        range: FittedRange,
+    ) -> Fitted {
+        Fitted {
+            relation,
+            values,
+            levels,
+            range,
+        }
+    }
+    /// `relation` with its published coefficients.
+    pub fn published(relation: Box<dyn Relation>) -> Fitted {
+        let values = relation.card().published_values();
+        Fitted::new(relation, values, BTreeMap::new(), FittedRange::default())
+    }
+    /// The relation.
+    pub fn relation(&self) -> &dyn Relation {
+        self.relation.as_ref()
+    }
+    /// What the relation is.
+    pub fn card(&self) -> &'static Card {
+        self.relation.card()
+    }
+    /// The coefficients, in [`Card::parameters`] order.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+    /// Per-subject effects (empty for published coefficients).
+    pub fn subject_levels(&self) -> &BTreeMap<String, f64> {
+        &self.levels
+    }
+    /// The input range the coefficients were fitted on (empty for the published coefficients
+    /// and for fits built in memory).
+    pub fn fitted_range(&self) -> FittedRange {
+        self.range
+    }
+    /// Sets the fitted input range.
+    pub fn set_fitted_range(&mut self, range: FittedRange) {
+        self.range = range;
+    }
+    /// Prediction for an average subject (offset 0).
+    pub fn predict(&self, x: &Inputs) -> f64 {
+        self.relation.predict_with(&self.values, 0.0, x)
+    }
+    /// Prediction with a per-subject offset on the [`SubjectEffect::on`] parameter.
+    pub fn predict_with_offset(&self, subject_offset: f64, x: &Inputs) -> f64 {
+        self.relation.predict_with(&self.values, subject_offset, x)
+    }
+    /// [`Fitted::predict`] with the rule of [`FittedRange`]: whether `x` lies inside the
+    /// fitted range, and outside it the boundary value held (inputs clamped to `[lo, hi]`).
+    pub fn predict_checked(&self, x: &Inputs) -> Prediction {
+        let at = Inputs {
+            values: self.range.hold(x),
+            output: x.output,
+        };
+        Prediction {
+            value: self.predict(&at),
+            inside: self.range.contains(x),
+            at: at.values,
+        }
+    }
+    /// Derived quantities at these coefficients ([`Relation::derived`]).
+    pub fn derived(&self) -> Vec<(String, f64, &'static str)> {
+        self.relation.derived(&self.values)
+    }
+}
+
 /// The input range a relation's coefficients were fitted on (a fits file's `valid_range`),
-/// one `[lo, hi]` per input in [`Relation::inputs`] order (`None`: not recorded, e.g. the
+/// one `[lo, hi]` per input in [`Card::inputs`] order (`None`: not recorded, e.g. the
 /// published coefficients).
 ///
 /// # Beyond the fitted range (the rule every prediction follows)
-/// [`Relation::predict_checked`] reports whether the inputs lie inside the range and, outside
+/// [`Fitted::predict_checked`] reports whether the inputs lie inside the range and, outside
 /// it, **holds the boundary value**: each input is clamped to `[lo, hi]` before the relation is
 /// evaluated, so no fitted curve is followed where no data constrained it. The typed methods the
 /// generators call follow the same rule for polynomial pieces of degree ≥ 2
@@ -432,7 +521,7 @@ impl FittedRange {
     }
 }
 
-/// A prediction with where it was evaluated ([`Relation::predict_checked`]).
+/// A prediction with where it was evaluated ([`Fitted::predict_checked`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prediction {
     /// The predicted response (papers' units), at `at`.
@@ -447,7 +536,7 @@ pub struct Prediction {
 /// The text a fit record carries under `outside_range` (the rule of [`FittedRange`]).
 pub const OUTSIDE_RANGE_RULE: &str = "predictions report whether their inputs lie inside \
     valid_range; outside it gaitfit holds the boundary value (each input clamped to [lo, hi] \
-    before evaluating: Relation::predict_checked); the generators' polynomial pieces of degree \
+    before evaluating: Fitted::predict_checked); the generators' polynomial pieces of degree \
     ≥ 2 (run-tflight-sf) do the same, straight-line relations extrapolate their line";
 
 /// A named set of coefficient values for one relation (what a fits file carries).
@@ -552,44 +641,33 @@ impl CoefficientSet {
     }
 }
 
-/// Every relation gaitfit knows, with published coefficients, in report order.
-pub fn registry() -> Vec<Box<dyn Relation>> {
-    vec![
-        Box::new(RunSlV::published()),
-        Box::new(RunTflightSf::published()),
-        Box::new(RunTflightSf::published_continuous()),
-        Box::new(WalkSlSf::published()),
-        Box::new(WalkTdsSf::published()),
-        Box::new(KbMu::published()),
-    ]
+/// The ids of every relation, in report order.
+pub fn ids() -> Vec<&'static str> {
+    registry().iter().map(|r| r.card().id).collect()
 }
 
 /// The relation with id `id` (published coefficients).
 pub fn by_id(id: &str) -> Result<Box<dyn Relation>, RelationError> {
     registry()
         .into_iter()
-        .find(|r| r.id() == id)
+        .find(|r| r.card().id == id)
         .ok_or_else(|| RelationError::UnknownRelation {
             id: id.to_string(),
-            known: registry()
-                .iter()
-                .map(|r| r.id())
-                .collect::<Vec<_>>()
-                .join(", "),
+            known: ids().join(", "),
         })
 }
 
 /// The relation of a fits file, with the refitted coefficients.
-pub fn from_coefficients(set: &CoefficientSet) -> Result<Box<dyn Relation>, RelationError> {
+pub fn from_coefficients(set: &CoefficientSet) -> Result<Fitted, RelationError> {
     let r = by_id(&set.relation)?;
-    let (vals, levels) = set.split(r.parameters(), r.subject_effect())?;
-    let mut out = r.with_values(&vals, levels);
-    out.set_fitted_range(FittedRange::of(set, out.inputs()));
-    Ok(out)
+    let card = r.card();
+    let (vals, levels) = set.split(card.parameters, card.subject_effect)?;
+    let range = FittedRange::of(set, card.inputs);
+    Ok(Fitted::new(r, vals, levels, range))
 }
 
 /// Loads `fits/<id>.json` as a relation with the refitted coefficients.
-pub fn load_fit(path: &Path) -> Result<Box<dyn Relation>, RelationError> {
+pub fn load_fit(path: &Path) -> Result<Fitted, RelationError> {
     from_coefficients(&CoefficientSet::from_fit_file(path)?)
 }
 
@@ -607,13 +685,13 @@ pub(crate) fn expect_id(set: &CoefficientSet, id: &str, path: &Path) -> Result<(
 
 /// The analytic gradient of the linear part (helper for relations whose breakpoints have no
 /// useful derivative): `∂y/∂p_i = g_j` for linear `i`, 0 for breakpoints.
-pub fn linear_gradient(r: &dyn Relation, p: &[f64], x: &[f64]) -> Vec<f64> {
+pub fn linear_gradient(r: &dyn Relation, p: &[f64], x: &Inputs) -> Vec<f64> {
     let mut g = [0.0; 16];
-    let nl = r.n_linear();
+    let nl = r.card().n_linear();
     r.raw_basis(p, x, &mut g[..nl]);
     let mut out = vec![0.0; p.len()];
     let mut j = 0;
-    for (i, s) in r.parameters().iter().enumerate() {
+    for (i, s) in r.card().parameters.iter().enumerate() {
         if s.kind == ParamKind::Linear {
             out[i] = g[j];
             j += 1;

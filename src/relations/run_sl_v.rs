@@ -19,11 +19,7 @@
 //! assert!((r.step_length(200.0, 1.8, 0.0) - 1.0694).abs() < 1e-9);
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
-use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
-    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, SubjectEffect,
-    Variable,
-};
+use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, SubjectEffect, Variable};
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{m_per_s_to_m_per_min, Quantity};
@@ -188,39 +184,43 @@ fn sl(p: &[f64], level: f64, v: f64, h: f64) -> f64 {
     p[0] + (p[1] + level) * z(p[2], v, h)
 }
 
-impl Relation for RunSlV {
-    fn id(&self) -> &'static str {
-        Self::ID
-    }
-    fn title(&self) -> &'static str {
-        "Running: step length from speed (Froude-normalised, with plateau)"
-    }
-    fn citation(&self) -> Citation {
-        Citation {
+/// What the relation is.
+static CARD: Card = Card {
+    id: RunSlV::ID,
+    title: "Running: step length from speed (Froude-normalised, with plateau)",
+    citation: Citation {
             paper: "Bruderlin & Calvert (1996), Knowledge-driven, interactive animation of human running",
             equation: "eq. 2 and v_norm (§2.2)",
-        }
-    }
-    fn equation(&self) -> &'static str {
-        "sl = a + (b + level)·min(v, v_norm·√(h/1.8))·√(h/1.8)"
-    }
-    fn response(&self) -> Variable {
-        Variable {
+        },
+    equation: "sl = a + (b + level)·min(v, v_norm·√(h/1.8))·√(h/1.8)",
+    response: Variable {
             symbol: "sl",
             unit: "m",
             name: "step length",
-        }
+        },
+    inputs: INPUTS,
+    outputs: &[Output {
+        name: "sl",
+        label: "sl",
+    }],
+    gait: Gait::Run,
+    needs: &[Quantity::Speed, Quantity::StepLength, Quantity::BodyHeight],
+    parameters: PARAMS,
+    subject_effect: Some(LEVEL),
+    has_intercept: true,
+    domain: Domain {
+            input: "v",
+            lo: 0.0,
+            hi: 400.0,
+            note: "regression data had v ≤ 400 m/min (n = 80, r² = 0.94442); constant above v_norm",
+        },
+};
+
+impl Relation for RunSlV {
+    fn card(&self) -> &'static Card {
+        &CARD
     }
-    fn inputs(&self) -> &'static [Variable] {
-        INPUTS
-    }
-    fn gait(&self) -> Gait {
-        Gait::Run
-    }
-    fn needs(&self) -> &'static [Quantity] {
-        &[Quantity::Speed, Quantity::StepLength, Quantity::BodyHeight]
-    }
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
+    fn observe(&self, row: &FieldValues, _output: usize) -> Result<Observation, Rejection> {
         let v = required(row, Quantity::Speed)?;
         let sl = required(row, Quantity::StepLength)?;
         let h = required(row, Quantity::BodyHeight)?;
@@ -230,56 +230,20 @@ impl Relation for RunSlV {
             )));
         }
         Ok(Observation {
-            x: [m_per_s_to_m_per_min(v), h, 0.0, 0.0],
+            x: Inputs::new(&[m_per_s_to_m_per_min(v), h, 0.0, 0.0]),
             y: sl,
         })
     }
-    fn parameters(&self) -> &'static [ParameterSpec] {
-        PARAMS
-    }
-    fn subject_effect(&self) -> Option<SubjectEffect> {
-        Some(LEVEL)
-    }
-    fn has_intercept(&self) -> bool {
-        true
-    }
-    fn domain(&self) -> Domain {
-        Domain {
-            input: "v",
-            lo: 0.0,
-            hi: 400.0,
-            note: "regression data had v ≤ 400 m/min (n = 80, r² = 0.94442); constant above v_norm",
-        }
-    }
-    fn values(&self) -> &[f64] {
-        &self.values
-    }
-    fn fitted_range(&self) -> FittedRange {
-        self.range
-    }
-    fn set_fitted_range(&mut self, range: FittedRange) {
-        self.range = range;
-    }
-    fn subject_levels(&self) -> &BTreeMap<String, f64> {
-        &self.levels
-    }
-    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]) {
+    fn raw_basis(&self, p: &[f64], x: &Inputs, g: &mut [f64]) {
         g[0] = 1.0;
         g[1] = z(p[2], x[0], x[1]);
     }
-    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    fn gradient(&self, p: &[f64], x: &Inputs) -> Option<Vec<f64>> {
         let mut d = linear_gradient(self, p, x);
         let r = (x[1] / REFERENCE_HEIGHT_M).sqrt();
         // On the plateau sl = a + b·v_norm·r², so ∂sl/∂v_norm = b·r²; 0 below.
         d[2] = if x[0] > p[2] * r { p[1] * r * r } else { 0.0 };
         Some(d)
-    }
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
-        Box::new(RunSlV {
-            values: values.to_vec(),
-            levels,
-            range: FittedRange::default(),
-        })
     }
     fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {
         let r = RunSlV::new(p[0], p[1], p[2]);

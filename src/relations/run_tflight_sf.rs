@@ -30,10 +30,7 @@
 //! assert!((r.flight_time(187.0) - 0.188).abs() < 0.0005); // running paper §3.1
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
-use super::{
-    expect_id, required, Citation, CoefficientSet, Domain, FittedRange, Observation, ParamKind,
-    ParameterSpec, Rejection, Relation, RelationError, Variable,
-};
+use super::{expect_id, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
@@ -240,86 +237,62 @@ pub(crate) fn jump(p: &[f64]) -> f64 {
     cubic(p, p[7]) - quad(p, p[7])
 }
 
+/// What the free-pieces variant is.
+const CARD_FREE: Card = Card {
+    id: RunTflightSf::ID,
+    title: "Running: flight time from step frequency (paper's free pieces)",
+    equation: "t_flight = q0 + q1·sf + q2·sf² (sf < k1); c0 + c1·s + c2·s² + c3·s³ with s = min(sf, k2) (sf ≥ k1)",
+    ..CARD_CONTINUOUS
+};
+
+/// What the continuous variant is.
+const CARD_CONTINUOUS: Card = Card {
+    id: RunTflightSf::ID_CONTINUOUS,
+    title: "Running: flight time from step frequency (continuous at k1)",
+    citation: Citation {
+        paper: "Bruderlin & Calvert (1996), Knowledge-driven, interactive animation of human running",
+        equation: "eqs. 4–5 (§2.2)",
+    },
+    equation: "t_flight = q0 + q1·sf + q2·sf² (sf < k1); c0 + c1·s + c2·s² + c3·s³ with s = min(sf, k2) (sf ≥ k1); q0 set so the pieces meet at k1",
+    response: Variable {
+        symbol: "t_flight",
+        unit: "s",
+        name: "flight time",
+    },
+    inputs: INPUTS,
+    outputs: &[Output {
+        name: "t_flight",
+        label: "t_flight",
+    }],
+    gait: Gait::Run,
+    needs: &[Quantity::StepFreq, Quantity::FlightTime],
+    parameters: PARAMS,
+    subject_effect: None,
+    has_intercept: true,
+    domain: Domain {
+        input: "sf",
+        lo: 160.0,
+        hi: 230.0,
+        note: "the cubic's data ranged about 160–230 steps/min (n = 20); below 180 the quadratic is an extrapolation",
+    },
+};
+
 impl Relation for RunTflightSf {
-    fn id(&self) -> &'static str {
+    fn card(&self) -> &'static Card {
         match self.continuity {
-            Continuity::Free => Self::ID,
-            Continuity::Continuous => Self::ID_CONTINUOUS,
+            Continuity::Free => &CARD_FREE,
+            Continuity::Continuous => &CARD_CONTINUOUS,
         }
     }
-    fn title(&self) -> &'static str {
-        match self.continuity {
-            Continuity::Free => "Running: flight time from step frequency (paper's free pieces)",
-            Continuity::Continuous => "Running: flight time from step frequency (continuous at k1)",
-        }
-    }
-    fn citation(&self) -> Citation {
-        Citation {
-            paper: "Bruderlin & Calvert (1996), Knowledge-driven, interactive animation of human running",
-            equation: "eqs. 4–5 (§2.2)",
-        }
-    }
-    fn equation(&self) -> &'static str {
-        match self.continuity {
-            Continuity::Free => {
-                "t_flight = q0 + q1·sf + q2·sf² (sf < k1); c0 + c1·s + c2·s² + c3·s³ with s = min(sf, k2) (sf ≥ k1)"
-            }
-            Continuity::Continuous => {
-                "t_flight = q0 + q1·sf + q2·sf² (sf < k1); c0 + c1·s + c2·s² + c3·s³ with s = min(sf, k2) (sf ≥ k1); q0 set so the pieces meet at k1"
-            }
-        }
-    }
-    fn response(&self) -> Variable {
-        Variable {
-            symbol: "t_flight",
-            unit: "s",
-            name: "flight time",
-        }
-    }
-    fn inputs(&self) -> &'static [Variable] {
-        INPUTS
-    }
-    fn gait(&self) -> Gait {
-        Gait::Run
-    }
-    fn needs(&self) -> &'static [Quantity] {
-        &[Quantity::StepFreq, Quantity::FlightTime]
-    }
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
+    fn observe(&self, row: &FieldValues, _output: usize) -> Result<Observation, Rejection> {
         let sf = required(row, Quantity::StepFreq)?;
         let tf = required(row, Quantity::FlightTime)?;
         Ok(Observation {
-            x: [hz_to_steps_per_min(sf), 0.0, 0.0, 0.0],
+            x: Inputs::new(&[hz_to_steps_per_min(sf)]),
             y: tf,
         })
     }
-    fn parameters(&self) -> &'static [ParameterSpec] {
-        PARAMS
-    }
-    fn has_intercept(&self) -> bool {
-        true
-    }
-    fn domain(&self) -> Domain {
-        Domain {
-            input: "sf",
-            lo: 160.0,
-            hi: 230.0,
-            note: "the cubic's data ranged about 160–230 steps/min (n = 20); below 180 the quadratic is an extrapolation",
-        }
-    }
-    fn values(&self) -> &[f64] {
-        &self.values
-    }
-    fn fitted_range(&self) -> FittedRange {
-        self.range
-    }
-    fn set_fitted_range(&mut self, range: FittedRange) {
-        self.range = range;
-    }
-    fn subject_levels(&self) -> &BTreeMap<String, f64> {
-        &self.levels
-    }
-    fn raw_basis(&self, p: &[f64], x: &[f64], g: &mut [f64]) {
+    fn raw_basis(&self, p: &[f64], x: &Inputs, g: &mut [f64]) {
         g[..7].fill(0.0);
         let sf = x[0];
         if sf < p[7] {
@@ -334,10 +307,10 @@ impl Relation for RunTflightSf {
             g[6] = s * s * s;
         }
     }
-    fn predict_with(&self, p: &[f64], _subject_offset: f64, x: &[f64]) -> f64 {
+    fn predict_with(&self, p: &[f64], _subject_offset: f64, x: &Inputs) -> f64 {
         tflight(p, x[0])
     }
-    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    fn gradient(&self, p: &[f64], x: &Inputs) -> Option<Vec<f64>> {
         let mut d = super::linear_gradient(self, p, x);
         // k1 moves a row between pieces (no derivative almost everywhere); k2 moves the plateau.
         if x[0] > p[8] && x[0] >= p[7] {
@@ -345,14 +318,6 @@ impl Relation for RunTflightSf {
             d[8] = p[4] + k2 * (2.0 * p[5] + 3.0 * k2 * p[6]);
         }
         Some(d)
-    }
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
-        Box::new(RunTflightSf {
-            values: values.to_vec(),
-            continuity: self.continuity,
-            levels,
-            range: FittedRange::default(),
-        })
     }
     fn derived(&self, p: &[f64]) -> Vec<(String, f64, &'static str)> {
         vec![

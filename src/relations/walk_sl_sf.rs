@@ -17,10 +17,7 @@
 //! assert!((w.step_freq_for_speed(v, 1.8) - 107.58).abs() < 0.01);
 //! assert!((w.step_length_for_speed(v, 1.8) - 0.7746).abs() < 0.0005);
 //! ```
-use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
-    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
-};
+use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
@@ -111,88 +108,59 @@ impl WalkSlSf {
     }
 }
 
-impl Relation for WalkSlSf {
-    fn id(&self) -> &'static str {
-        Self::ID
-    }
-    fn title(&self) -> &'static str {
-        "Walking: step length from step frequency and body height (normalising formula)"
-    }
-    fn citation(&self) -> Citation {
-        Citation {
+/// What the relation is.
+static CARD: Card = Card {
+    id: WalkSlSf::ID,
+    title: "Walking: step length from step frequency and body height (normalising formula)",
+    citation: Citation {
             paper: "Bruderlin & Calvert (1989), Goal-directed, dynamic animation of human walking",
             equation: "eq. 1 (§3)",
-        }
-    }
-    fn equation(&self) -> &'static str {
-        "sl = k·sf·h (through the origin)"
-    }
-    fn response(&self) -> Variable {
-        Variable {
+        },
+    equation: "sl = k·sf·h (through the origin)",
+    response: Variable {
             symbol: "sl",
             unit: "m",
             name: "step length",
-        }
-    }
-    fn inputs(&self) -> &'static [Variable] {
-        INPUTS
-    }
-    fn gait(&self) -> Gait {
-        Gait::Walk
-    }
-    fn needs(&self) -> &'static [Quantity] {
-        &[
+        },
+    inputs: INPUTS,
+    outputs: &[Output {
+        name: "sl",
+        label: "sl",
+    }],
+    gait: Gait::Walk,
+    needs: &[
             Quantity::StepLength,
             Quantity::StepFreq,
             Quantity::BodyHeight,
-        ]
-    }
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let sl = required(row, Quantity::StepLength)?;
-        let sf = required(row, Quantity::StepFreq)?;
-        let h = required(row, Quantity::BodyHeight)?;
-        Ok(Observation {
-            x: [hz_to_steps_per_min(sf), h, 0.0, 0.0],
-            y: sl,
-        })
-    }
-    fn parameters(&self) -> &'static [ParameterSpec] {
-        PARAMS
-    }
-    fn has_intercept(&self) -> bool {
-        false
-    }
-    fn domain(&self) -> Domain {
-        Domain {
+        ],
+    parameters: PARAMS,
+    subject_effect: None,
+    has_intercept: false,
+    domain: Domain {
             input: "sf",
             lo: 0.0,
             hi: 182.0,
             note: "KLAW's anatomical limit sf_max = 182 steps/min (§3)",
-        }
+        },
+};
+
+impl Relation for WalkSlSf {
+    fn card(&self) -> &'static Card {
+        &CARD
     }
-    fn values(&self) -> &[f64] {
-        &self.values
+    fn observe(&self, row: &FieldValues, _output: usize) -> Result<Observation, Rejection> {
+        let sl = required(row, Quantity::StepLength)?;
+        let sf = required(row, Quantity::StepFreq)?;
+        let h = required(row, Quantity::BodyHeight)?;
+        Ok(Observation {
+            x: Inputs::new(&[hz_to_steps_per_min(sf), h, 0.0, 0.0]),
+            y: sl,
+        })
     }
-    fn fitted_range(&self) -> FittedRange {
-        self.range
-    }
-    fn set_fitted_range(&mut self, range: FittedRange) {
-        self.range = range;
-    }
-    fn subject_levels(&self) -> &BTreeMap<String, f64> {
-        &self.levels
-    }
-    fn raw_basis(&self, _p: &[f64], x: &[f64], g: &mut [f64]) {
+    fn raw_basis(&self, _p: &[f64], x: &Inputs, g: &mut [f64]) {
         g[0] = x[0] * x[1];
     }
-    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    fn gradient(&self, p: &[f64], x: &Inputs) -> Option<Vec<f64>> {
         Some(linear_gradient(self, p, x))
-    }
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
-        Box::new(WalkSlSf {
-            values: values.to_vec(),
-            levels,
-            range: FittedRange::default(),
-        })
     }
 }

@@ -16,10 +16,7 @@
 //! // t_ds at 120 steps/min: (29.08 − 19.2) % of a 1 s cycle = 0.0988 s.
 //! assert!((w.double_support_time(120.0) - 0.0988).abs() < 1e-12);
 //! ```
-use super::{
-    expect_id, linear_gradient, required, Citation, CoefficientSet, Domain, FittedRange,
-    Observation, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable,
-};
+use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
 use crate::events::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
@@ -110,84 +107,55 @@ impl WalkTdsSf {
     }
 }
 
-impl Relation for WalkTdsSf {
-    fn id(&self) -> &'static str {
-        Self::ID
-    }
-    fn title(&self) -> &'static str {
-        "Walking: double support (% of cycle) from step frequency"
-    }
-    fn citation(&self) -> Citation {
-        Citation {
+/// What the relation is.
+static CARD: Card = Card {
+    id: WalkTdsSf::ID,
+    title: "Walking: double support (% of cycle) from step frequency",
+    citation: Citation {
             paper: "Bruderlin & Calvert (1989), Goal-directed, dynamic animation of human walking",
             equation: "t_ds formula (§3, state-phase timings)",
-        }
-    }
-    fn equation(&self) -> &'static str {
-        "100·t_ds/t_cycle = d0 + d1·sf"
-    }
-    fn response(&self) -> Variable {
-        Variable {
+        },
+    equation: "100·t_ds/t_cycle = d0 + d1·sf",
+    response: Variable {
             symbol: "t_ds/t_cycle",
             unit: "%",
             name: "double support (one step) as % of the cycle",
-        }
-    }
-    fn inputs(&self) -> &'static [Variable] {
-        INPUTS
-    }
-    fn gait(&self) -> Gait {
-        Gait::Walk
-    }
-    fn needs(&self) -> &'static [Quantity] {
-        &[Quantity::StepFreq, Quantity::DoubleSupportPct]
-    }
-    fn observe(&self, row: &FieldValues) -> Result<Observation, Rejection> {
-        let sf = required(row, Quantity::StepFreq)?;
-        let pct = required(row, Quantity::DoubleSupportPct)?;
-        Ok(Observation {
-            x: [hz_to_steps_per_min(sf), 0.0, 0.0, 0.0],
-            y: pct,
-        })
-    }
-    fn parameters(&self) -> &'static [ParameterSpec] {
-        PARAMS
-    }
-    fn has_intercept(&self) -> bool {
-        true
-    }
-    fn domain(&self) -> Domain {
-        Domain {
+        },
+    inputs: INPUTS,
+    outputs: &[Output {
+        name: "t_ds/t_cycle",
+        label: "t_ds/t_cycle",
+    }],
+    gait: Gait::Walk,
+    needs: &[Quantity::StepFreq, Quantity::DoubleSupportPct],
+    parameters: PARAMS,
+    subject_effect: None,
+    has_intercept: true,
+    domain: Domain {
             input: "sf",
             lo: 0.0,
             hi: 182.0,
             note: "walking; t_ds vanishes (walk → run) at sf = 181.75 steps/min with the published values",
-        }
+        },
+};
+
+impl Relation for WalkTdsSf {
+    fn card(&self) -> &'static Card {
+        &CARD
     }
-    fn values(&self) -> &[f64] {
-        &self.values
+    fn observe(&self, row: &FieldValues, _output: usize) -> Result<Observation, Rejection> {
+        let sf = required(row, Quantity::StepFreq)?;
+        let pct = required(row, Quantity::DoubleSupportPct)?;
+        Ok(Observation {
+            x: Inputs::new(&[hz_to_steps_per_min(sf), 0.0, 0.0, 0.0]),
+            y: pct,
+        })
     }
-    fn fitted_range(&self) -> FittedRange {
-        self.range
-    }
-    fn set_fitted_range(&mut self, range: FittedRange) {
-        self.range = range;
-    }
-    fn subject_levels(&self) -> &BTreeMap<String, f64> {
-        &self.levels
-    }
-    fn raw_basis(&self, _p: &[f64], x: &[f64], g: &mut [f64]) {
+    fn raw_basis(&self, _p: &[f64], x: &Inputs, g: &mut [f64]) {
         g[0] = 1.0;
         g[1] = x[0];
     }
-    fn gradient(&self, p: &[f64], x: &[f64]) -> Option<Vec<f64>> {
+    fn gradient(&self, p: &[f64], x: &Inputs) -> Option<Vec<f64>> {
         Some(linear_gradient(self, p, x))
-    }
-    fn with_values(&self, values: &[f64], levels: BTreeMap<String, f64>) -> Box<dyn Relation> {
-        Box::new(WalkTdsSf {
-            values: values.to_vec(),
-            levels,
-            range: FittedRange::default(),
-        })
     }
 }

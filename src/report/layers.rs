@@ -288,12 +288,12 @@ pub struct Frame<'a> {
 impl<'a> Frame<'a> {
     /// The rows of `o`, coloured by `groups`.
     pub fn new(o: &'a FitOutcome, groups: &'a Groups) -> Frame<'a> {
-        let rel = o.refit.as_ref();
-        let outputs = (rel.outputs() > 1).then(|| {
+        let rel = o.refit.relation();
+        let outputs = (rel.card().outputs.len() > 1).then(|| {
             o.prepared
                 .obs
                 .iter()
-                .map(|ob| rel.output_of(&ob.x).min(255) as u8)
+                .map(|ob| ob.x.output.min(255) as u8)
                 .collect()
         });
         Frame { o, groups, outputs }
@@ -357,7 +357,7 @@ impl<'a> Frame<'a> {
             let g = &mut gi[self.groups.of(p, i) as usize];
             g.n += 1;
             g.x0 = (g.x0.0.min(ob.x[0]), g.x0.1.max(ob.x[0]));
-            for (m, x) in g.mean.iter_mut().zip(ob.x) {
+            for (m, x) in g.mean.iter_mut().zip(ob.x.values) {
                 *m += x;
             }
             for (s, e) in sources.iter().zip(e.iter_mut()) {

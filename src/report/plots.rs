@@ -28,7 +28,7 @@ use super::layers::{
 use super::{qq, raster, ticks, Figure, ReportError};
 use crate::fit::pipeline::FitOutcome;
 use crate::fsio::write_atomic_bytes;
-use crate::relations::{Relation, MAX_INPUTS};
+use crate::relations::{Inputs, Relation, MAX_INPUTS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -148,40 +148,23 @@ struct Spec {
     drawn: String,
 }
 
-/// The curve-evaluation point `x` for output `out` with input 0 at `x0` and other inputs at
-/// `base`.
-fn at(
-    rel: &dyn Relation,
-    base: &[f64; MAX_INPUTS],
-    out: Option<usize>,
-    x0: f64,
-) -> [f64; MAX_INPUTS] {
-    let mut x = *base;
-    if let Some(k) = out {
-        rel.select_output(&mut x, k);
-    }
-    x[0] = x0;
+/// The curve-evaluation point for output `out` (0 when `None`) with input 0 at `x0` and other
+/// inputs at `base`.
+fn at(base: &[f64; MAX_INPUTS], out: Option<usize>, x0: f64) -> Inputs {
+    let mut x = Inputs {
+        values: *base,
+        output: out.unwrap_or(0),
+    };
+    x.values[0] = x0;
     x
-}
-
-/// The input that selects the output of a multi-output relation (kb-mu's μ index), if any:
-/// not a predictor, so not an axis.
-fn selector_input(rel: &dyn Relation) -> Option<usize> {
-    if rel.outputs() < 2 {
-        return None;
-    }
-    let mut a = [0.0; MAX_INPUTS];
-    let mut b = [0.0; MAX_INPUTS];
-    rel.select_output(&mut a, 0);
-    rel.select_output(&mut b, 1);
-    (0..MAX_INPUTS).find(|&j| a[j] != b[j])
 }
 
 /// Whether the paper gives every coefficient of the published curve (no line otherwise: a
 /// curve through made-up values would look like the paper's).
 fn published_given(o: &FitOutcome) -> bool {
-    let rel = o.published.as_ref();
-    rel.parameters()
+    let rel = o.published.relation();
+    rel.card()
+        .parameters
         .iter()
         .all(|s| s.cited && s.published.is_finite())
 }
@@ -190,9 +173,9 @@ fn published_given(o: &FitOutcome) -> bool {
 /// does not cite a value for but bounds (Ko–Badler's α); empty when it cites every value, or
 /// when some uncited coefficient has no range either (then the paper says nothing to draw).
 fn ranged_only(o: &FitOutcome) -> Vec<(usize, f64, f64)> {
-    let rel = o.published.as_ref();
+    let rel = o.published.relation();
     let mut out = Vec::new();
-    for (i, s) in rel.parameters().iter().enumerate() {
+    for (i, s) in rel.card().parameters.iter().enumerate() {
         if s.cited && s.published.is_finite() {
             continue;
         }
@@ -231,9 +214,9 @@ fn constraint_family(
     Vec<(f64, f64, f64)>,
     Option<(f64, f64)>,
 ) {
-    let rel = o.published.as_ref();
-    let p0: Vec<f64> = rel.parameters().iter().map(|s| s.published).collect();
-    let eval = |p: &[f64], x0: f64| rel.predict_with(p, 0.0, &at(rel, base, out, x0));
+    let rel = o.published.relation();
+    let p0: Vec<f64> = rel.card().parameters.iter().map(|s| s.published).collect();
+    let eval = |p: &[f64], x0: f64| rel.predict_with(p, 0.0, &at(base, out, x0));
     // The pivot: where the curve stops depending on each ranged coefficient that matters here
     // (a sign change of the unit-step difference between grid points, linear in between).
     let grid: Vec<f64> = xs(xlo, xhi).collect();
@@ -422,7 +405,7 @@ fn constraint_words(o: &FitOutcome, ranged: &[(usize, f64, f64)]) -> Option<Stri
     if ranged.is_empty() {
         return None;
     }
-    let specs = o.published.parameters();
+    let specs = o.published.card().parameters;
     let range = |lo: f64, hi: f64| match (lo.is_finite(), hi.is_finite()) {
         (true, true) => format!("∈ [{}, {}]", fmt_num(lo), fmt_num(hi)),
         (true, false) => format!("≥ {}", fmt_num(lo)),
@@ -445,8 +428,8 @@ fn constraint_words(o: &FitOutcome, ranged: &[(usize, f64, f64)]) -> Option<Stri
 
 /// The data figure's sources: one panel per output.
 fn main_sources(rel: &dyn Relation) -> Vec<Source> {
-    let outs: Vec<Option<usize>> = if rel.outputs() > 1 {
-        (0..rel.outputs()).map(Some).collect()
+    let outs: Vec<Option<usize>> = if rel.card().outputs.len() > 1 {
+        (0..rel.card().outputs.len()).map(Some).collect()
     } else {
         vec![None]
     };
@@ -462,12 +445,11 @@ fn main_sources(rel: &dyn Relation) -> Vec<Source> {
 /// Builds the data figure (one panel per output), its data layer still empty.
 fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInputs]) -> Spec {
     let o = frame.o;
-    let rel = o.refit.as_ref();
+    let rel = o.refit.relation();
     let id = &o.record.relation;
-    let n_out = rel.outputs();
-    let inputs = rel.inputs();
-    let resp = rel.response();
-    let sel = selector_input(rel);
+    let n_out = rel.card().outputs.len();
+    let inputs = rel.card().inputs;
+    let resp = rel.card().response;
     let outs: Vec<Option<usize>> = sources.iter().map(|s| s.output).collect();
     let total: usize = gin.iter().map(|g| g.n).sum();
     let mut mean_x = [0.0; MAX_INPUTS];
@@ -477,10 +459,10 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
         }
     }
     // Other continuous inputs (body height): curves are drawn at their mean, and per group.
-    let others: Vec<usize> = (1..inputs.len()).filter(|&j| Some(j) != sel).collect();
-    let levels = rel.subject_levels();
+    let others: Vec<usize> = (1..inputs.len()).collect();
+    let levels = o.refit.subject_levels();
     let per_group =
-        frame.groups.len() > 1 && (!others.is_empty() || rel.subject_effect().is_some());
+        frame.groups.len() > 1 && (!others.is_empty() || rel.card().subject_effect.is_some());
     let published = published_given(o);
     let ranged = if published {
         Vec::new()
@@ -496,7 +478,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
         let mut refit = Vec::with_capacity(CURVE_POINTS + 1);
         let mut publ = Vec::new();
         for x0 in xs(xlo, xhi) {
-            let x = at(rel, &mean_x, out, x0);
+            let x = at(&mean_x, out, x0);
             let (m, lo, hi) = o.band(&x);
             band.push((x0, lo, hi));
             refit.push((x0, m));
@@ -517,7 +499,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
                     .unwrap_or(0.0);
                 let pts = xs(gi.x0.0, gi.x0.1)
                     .map(|x0| {
-                        let x = at(rel, &gi.mean, out, x0);
+                        let x = at(&gi.mean, out, x0);
                         (x0, rel.predict_with(&o.values, level, &x))
                     })
                     .collect();
@@ -568,7 +550,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
             pivot: pivot.filter(|p| p.1 >= y.0 && p.1 <= y.1),
         });
         let y_desc = match out {
-            Some(k) => format!("{} ({})", rel.output_name(k), resp.unit),
+            Some(k) => format!("{} ({})", rel.card().outputs[k].name, resp.unit),
             None => format!("{} ({})", resp.symbol, resp.unit),
         };
         panels.push(Panel {
@@ -625,7 +607,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
             let syms: Vec<&str> = others.iter().map(|&j| inputs[j].symbol).collect();
             what.push_str(&format!(" at its mean {}", syms.join(", ")));
         }
-        if rel.subject_effect().is_some() && frame.groups.by == GroupBy::Subject {
+        if rel.card().subject_effect.is_some() && frame.groups.by == GroupBy::Subject {
             what.push_str(if others.is_empty() {
                 " with its level"
             } else {
@@ -662,7 +644,7 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
     if n_out > 1 {
         shows.push_str(&format!("; one panel per output ({n_out})"));
     }
-    let mut title = format!("{id} — {}", rel.citation().equation);
+    let mut title = format!("{id} — {}", rel.card().citation.equation);
     if n_out > 1 {
         title = format!("{id} — one panel per output");
     }
@@ -684,29 +666,26 @@ fn main_spec(frame: &Frame, sources: &[Source], ext: &[Extent], gin: &[GroupInpu
 
 /// The label of output `k`'s panel.
 fn output_title(rel: &dyn Relation, k: usize) -> String {
-    rel.output_label(k)
+    rel.card().outputs[k].label.to_string()
 }
 
 /// The sources of the residual figures: against fitted values, or against each input (one
 /// panel per input and output).
 fn residual_sources(rel: &dyn Relation, against_inputs: bool) -> Vec<Source> {
-    let sel = selector_input(rel);
     let mut sources = Vec::new();
     if against_inputs {
-        let outs: Vec<Option<usize>> = if rel.outputs() > 1 {
-            (0..rel.outputs()).map(Some).collect()
+        let outs: Vec<Option<usize>> = if rel.card().outputs.len() > 1 {
+            (0..rel.card().outputs.len()).map(Some).collect()
         } else {
             vec![None]
         };
         for out in outs {
-            for j in 0..rel.inputs().len() {
-                if Some(j) != sel {
-                    sources.push(Source {
-                        x: Axis::Input(j),
-                        y: Axis::Residual,
-                        output: out,
-                    });
-                }
+            for j in 0..rel.card().inputs.len() {
+                sources.push(Source {
+                    x: Axis::Input(j),
+                    y: Axis::Residual,
+                    output: out,
+                });
             }
         }
     } else {
@@ -722,9 +701,9 @@ fn residual_sources(rel: &dyn Relation, against_inputs: bool) -> Vec<Source> {
 /// A residual figure (see [`residual_sources`]), its data layer still empty.
 fn residual_spec(frame: &Frame, sources: &[Source], ext: &[Extent], against_inputs: bool) -> Spec {
     let o = frame.o;
-    let rel = o.refit.as_ref();
+    let rel = o.refit.relation();
     let id = &o.record.relation;
-    let resp = rel.response();
+    let resp = rel.card().response;
     let grid = grid_for(sources.len());
     let panels: Vec<Panel> = sources
         .iter()
@@ -734,7 +713,7 @@ fn residual_spec(frame: &Frame, sources: &[Source], ext: &[Extent], against_inpu
             let y = pad(e.y.0.min(0.0), e.y.1.max(0.0));
             let x_desc = match src.x {
                 Axis::Input(j) => {
-                    let v = rel.inputs()[j];
+                    let v = rel.card().inputs[j];
                     format!("{} ({})", v.symbol, v.unit)
                 }
                 _ => format!("fitted {} ({})", resp.symbol, resp.unit),
@@ -799,7 +778,7 @@ fn residual_spec(frame: &Frame, sources: &[Source], ext: &[Extent], against_inpu
 fn qq_spec(frame: &Frame) -> Spec {
     let o = frame.o;
     let id = &o.record.relation;
-    let resp = o.refit.response();
+    let resp = o.refit.card().response;
     let q = qq::qq_points(&o.residuals, MAX_SCATTER_POINTS);
     let (pts, n, mean, sd) = (q.pts, q.n, q.mean, q.sd);
     let (xlo, xhi) = pts.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
@@ -1286,7 +1265,7 @@ fn with_density_max(mut s: Spec) -> Spec {
 /// The figures of one fit, reduced (no drawing yet): two passes over the rows for all figures
 /// (extents; then points or density cells), plus the Q–Q plot's passes over the residuals.
 fn specs(o: &FitOutcome) -> Vec<Spec> {
-    let rel = o.refit.as_ref();
+    let rel = o.refit.relation();
     let groups = Groups::new(&o.prepared);
     let frame = Frame::new(o, &groups);
     let src = [

@@ -92,7 +92,8 @@ pub fn reference_words(r: &FitRecord) -> Option<String> {
         .iter()
         .filter(|c| c.published.is_none())
         .filter_map(|c| {
-            rel.parameters()
+            rel.card()
+                .parameters
                 .iter()
                 .find(|s| s.name == c.name && !s.cited)
         })

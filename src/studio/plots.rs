@@ -86,8 +86,8 @@ fn sample(lo: f64, hi: f64, f: impl Fn(f64) -> f64) -> Vec<[f64; 2]> {
 fn title(id: &str) -> String {
     by_id(id)
         .map(|r| {
-            let c = r.citation();
-            format!("{} — {}", r.title(), c.equation)
+            let c = r.card().citation;
+            format!("{} — {}", r.card().title, c.equation)
         })
         .unwrap_or_else(|_| id.to_string())
 }
@@ -277,13 +277,13 @@ pub fn data_points(dir: &Path) -> (BTreeMap<String, DataPoints>, Vec<String>) {
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         for r in &rels {
-            let d = out.entry(r.id().to_string()).or_default();
+            let d = out.entry(r.card().id.to_string()).or_default();
             let before = d.points.len();
             for i in 0..table.len() {
-                if table.is_flagged[i] || table.gait[i] != Some(r.gait()) {
+                if table.is_flagged[i] || table.gait[i] != Some(r.card().gait) {
                     continue;
                 }
-                if let Ok(o) = r.observe(&table.values(i)) {
+                if let Ok(o) = r.observe(&table.values(i), 0) {
                     if o.x[0].is_finite() && o.y.is_finite() {
                         d.points.push([o.x[0], o.y]);
                     }
@@ -291,7 +291,7 @@ pub fn data_points(dir: &Path) -> (BTreeMap<String, DataPoints>, Vec<String>) {
             }
             let n = d.points.len() - before;
             if n > 0 {
-                used.entry(r.id())
+                used.entry(r.card().id)
                     .or_default()
                     .push(format!("{name} ({n})"));
             }

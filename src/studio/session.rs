@@ -914,7 +914,8 @@ fn kb_alpha(path: &Path) -> Result<[f64; 4], StudioError> {
     for (i, slot) in a.iter_mut().enumerate() {
         let name = format!("alpha{}", i + 1);
         let idx = rel
-            .parameters()
+            .card()
+            .parameters
             .iter()
             .position(|p| p.name == name)
             .ok_or_else(|| {

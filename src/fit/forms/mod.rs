@@ -15,7 +15,7 @@
 //! | `run-tflight-sf`, `run-tflight-sf-continuous` | [`run_tflight_sf::TflightForm`]: centred bases, continuity at k1, sorted profile over sf |
 //! | `kb-mu` | [`kb_mu::MuForm`]: sl* and ll(S*) held (not identifiable beside free μ*) |
 //! | `walk-sl-sf`, `walk-tds-sf` | [`Raw`] |
-use crate::relations::{Observation, ParamKind, Relation};
+use crate::relations::{Inputs, Observation, ParamKind, Relation};
 use nalgebra::{DMatrix, DVector};
 
 pub mod kb_mu;
@@ -252,20 +252,22 @@ pub trait Form: Sync {
     fn plan(&self, rel: &dyn Relation, _obs: &[Observation]) -> Plan {
         Plan {
             held: rel
-                .parameters()
+                .card()
+                .parameters
                 .iter()
                 .map(|s| match s.kind {
                     ParamKind::Linear => None,
                     ParamKind::Breakpoint => Some("not fitted by this relation".to_string()),
                 })
                 .collect(),
-            search: vec![None; rel.parameters().len()],
+            search: vec![None; rel.card().parameters.len()],
         }
     }
 
     /// Number of basis columns for the free linear parameters `free` (mask over all params).
     fn basis_len(&self, rel: &dyn Relation, free: &[bool]) -> usize {
-        rel.parameters()
+        rel.card()
+            .parameters
             .iter()
             .zip(free)
             .filter(|(s, f)| s.kind == ParamKind::Linear && **f)
@@ -281,16 +283,17 @@ pub trait Form: Sync {
         rel: &dyn Relation,
         p: &[f64],
         free: &[bool],
-        x: &[f64],
+        x: &Inputs,
         phi: &mut [f64],
     ) -> f64 {
         let mut g = [0.0; 16];
-        let nl = rel.n_linear();
+        let nl = rel.card().n_linear();
         rel.raw_basis(p, x, &mut g[..nl]);
         let mut k = 0;
         let mut offset = 0.0;
         for (j, (i, _)) in rel
-            .parameters()
+            .card()
+            .parameters
             .iter()
             .enumerate()
             .filter(|(_, s)| s.kind == ParamKind::Linear)
@@ -309,7 +312,7 @@ pub trait Form: Sync {
     /// Maps basis coefficients to the linear parameters (see [`LinearMap`]); must match
     /// [`Form::basis`].
     fn basis_to_params(&self, rel: &dyn Relation, p: &[f64], free: &[bool]) -> LinearMap {
-        let specs = rel.parameters();
+        let specs = rel.card().parameters;
         let lin: Vec<usize> = (0..specs.len())
             .filter(|&i| specs[i].kind == ParamKind::Linear)
             .collect();
@@ -332,9 +335,9 @@ pub trait Form: Sync {
     /// [`crate::relations::SubjectEffect::on`] parameter). The default finds `on` among the free
     /// linear parameters of the raw basis.
     fn subject_column(&self, rel: &dyn Relation, free: &[bool]) -> Option<usize> {
-        let on = rel.subject_effect()?.on;
+        let on = rel.card().subject_effect?.on;
         let mut k = 0;
-        for (i, s) in rel.parameters().iter().enumerate() {
+        for (i, s) in rel.card().parameters.iter().enumerate() {
             if s.kind == ParamKind::Linear && free[i] {
                 if s.name == on {
                     return Some(k);
@@ -385,7 +388,7 @@ pub trait Fitting {
     /// [`Form::basis_len`].
     fn basis_len(&self, free: &[bool]) -> usize;
     /// [`Form::basis`].
-    fn basis(&self, p: &[f64], free: &[bool], x: &[f64], phi: &mut [f64]) -> f64;
+    fn basis(&self, p: &[f64], free: &[bool], x: &Inputs, phi: &mut [f64]) -> f64;
     /// [`Form::basis_to_params`].
     fn basis_to_params(&self, p: &[f64], free: &[bool]) -> LinearMap;
     /// [`Form::subject_column`].
@@ -398,25 +401,25 @@ pub trait Fitting {
 
 impl Fitting for dyn Relation + '_ {
     fn plan(&self, obs: &[Observation]) -> Plan {
-        form_of(self.id()).plan(self, obs)
+        form_of(self.card().id).plan(self, obs)
     }
     fn basis_len(&self, free: &[bool]) -> usize {
-        form_of(self.id()).basis_len(self, free)
+        form_of(self.card().id).basis_len(self, free)
     }
-    fn basis(&self, p: &[f64], free: &[bool], x: &[f64], phi: &mut [f64]) -> f64 {
-        form_of(self.id()).basis(self, p, free, x, phi)
+    fn basis(&self, p: &[f64], free: &[bool], x: &Inputs, phi: &mut [f64]) -> f64 {
+        form_of(self.card().id).basis(self, p, free, x, phi)
     }
     fn basis_to_params(&self, p: &[f64], free: &[bool]) -> LinearMap {
-        form_of(self.id()).basis_to_params(self, p, free)
+        form_of(self.card().id).basis_to_params(self, p, free)
     }
     fn subject_column(&self, free: &[bool]) -> Option<usize> {
-        form_of(self.id()).subject_column(self, free)
+        form_of(self.card().id).subject_column(self, free)
     }
     fn sorted_profile(&self) -> Option<&'static dyn SortedProfile> {
-        form_of(self.id()).sorted_profile()
+        form_of(self.card().id).sorted_profile()
     }
     fn breakpoint_null(&self, i: usize) -> Option<f64> {
-        form_of(self.id()).breakpoint_null(i)
+        form_of(self.card().id).breakpoint_null(i)
     }
 }
 
@@ -480,7 +483,7 @@ pub(crate) mod sorted_check {
                 }
             }
         }
-        let what = format!("{} p={p:?} free={free:?}", rel.id());
+        let what = format!("{} p={p:?} free={free:?}", rel.card().id);
         // Entries of all-but-zero columns carry the rounding of their terms, not of their
         // value: floor the diagonal at a millionth of the largest.
         let floor = 1e-6 * (0..nb).map(|a| want.xtx[a * nb + a]).fold(0.0, f64::max);

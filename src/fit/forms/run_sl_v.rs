@@ -106,6 +106,7 @@ impl SortedProfile for SlVForm {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::relations::Inputs;
     use crate::relations::RunSlV;
 
     #[test]
@@ -118,7 +119,7 @@ mod tests {
                 let v = 100.0 + 1.3 * (i % 290) as f64;
                 let h = 1.6 + 0.05 * (i % 7) as f64;
                 Observation {
-                    x: [v, h, 0.0, 0.0],
+                    x: Inputs::new(&[v, h, 0.0, 0.0]),
                     y: sl(&[0.14, 0.0046, 400.0], 0.0, v, h) + 0.01 * ((i % 3) as f64 - 1.0),
                 }
             })

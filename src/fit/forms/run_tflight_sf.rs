@@ -9,7 +9,7 @@ use super::{
     SortedProfile,
 };
 use crate::relations::run_tflight_sf::{cubic, quad, tflight};
-use crate::relations::{Continuity, Observation, Relation, RunTflightSf};
+use crate::relations::{Continuity, Inputs, Observation, Relation, RunTflightSf};
 use nalgebra::{DMatrix, DVector};
 
 /// The form of [`RunTflightSf`], per variant.
@@ -115,7 +115,7 @@ impl Form for TflightForm {
         _rel: &dyn Relation,
         p: &[f64],
         free: &[bool],
-        x: &[f64],
+        x: &Inputs,
         phi: &mut [f64],
     ) -> f64 {
         let l = Layout::new(p, free, self.continuity);
@@ -672,7 +672,7 @@ mod tests {
                 }
                 let mut phi = vec![0.0; 8];
                 for sf in [150.0, 179.9, 180.0, 200.0, 229.0, 240.0] {
-                    let off = r.basis(&p, &free, &[sf], &mut phi);
+                    let off = r.basis(&p, &free, &Inputs::new(&[sf]), &mut phi);
                     let y: f64 = off + (0..nb).map(|i| phi[i] * beta[i]).sum::<f64>();
                     let want = tflight(&p2, sf);
                     assert!(
@@ -694,7 +694,7 @@ mod tests {
             .map(|i| {
                 let sf = 120.0 + (i % 141) as f64 + 0.37 * ((i * 7) % 3) as f64;
                 Observation {
-                    x: [sf, 0.0, 0.0, 0.0],
+                    x: Inputs::new(&[sf, 0.0, 0.0, 0.0]),
                     y: tflight(RunTflightSf::published().coefficients(), sf)
                         + 0.002 * ((i % 5) as f64 - 2.0),
                 }
@@ -732,7 +732,7 @@ mod tests {
         let form = r.sorted_profile().expect("sorted form");
         let obs: Vec<Observation> = (0..60)
             .map(|i| Observation {
-                x: [150.0 + 2.0 * (i % 45) as f64, 0.0, 0.0, 0.0],
+                x: Inputs::new(&[150.0 + 2.0 * (i % 45) as f64, 0.0, 0.0, 0.0]),
                 y: 0.1,
             })
             .collect();

@@ -4,7 +4,7 @@ use super::{FitOutcome, CONFIDENCE};
 use crate::fit::design::{Covariance, Layout, MAX_BASIS};
 use crate::fit::forms::Fitting;
 use crate::fit::stats::t_quantile;
-use crate::relations::Relation;
+use crate::relations::{Inputs, Relation};
 use nalgebra::DVector;
 
 /// What the confidence band of the mean prediction needs.
@@ -19,13 +19,13 @@ pub(super) struct Band {
 
 impl Band {
     /// The mean prediction at `x` for parameters `p` and basis coefficients `coef`.
-    fn mean(&self, rel: &dyn Relation, p: &[f64], coef: &DVector<f64>, x: &[f64]) -> f64 {
+    fn mean(&self, rel: &dyn Relation, p: &[f64], coef: &DVector<f64>, x: &Inputs) -> f64 {
         let mut phi = [0.0; MAX_BASIS];
         let off = rel.basis(p, &self.lay.free, x, &mut phi[..self.lay.nb]);
         off + (0..self.lay.nb).map(|j| phi[j] * coef[j]).sum::<f64>()
     }
     /// The gradient of the mean prediction over θ.
-    fn ell(&self, rel: &dyn Relation, p: &[f64], x: &[f64]) -> DVector<f64> {
+    fn ell(&self, rel: &dyn Relation, p: &[f64], x: &Inputs) -> DVector<f64> {
         let lay = &self.lay;
         let mut phi = [0.0; MAX_BASIS];
         rel.basis(p, &lay.free, x, &mut phi[..lay.nb]);
@@ -61,8 +61,8 @@ pub(super) fn step(t: f64) -> f64 {
 impl FitOutcome {
     /// The refit prediction for an average subject at `x` with its 95 % confidence band
     /// (under the fit's inference method): `(mean, lo, hi)`.
-    pub fn band(&self, x: &[f64]) -> (f64, f64, f64) {
-        let rel = self.refit.as_ref();
+    pub fn band(&self, x: &Inputs) -> (f64, f64, f64) {
+        let rel = self.refit.relation();
         let b = &self.band;
         let m = b.mean(rel, &self.values, &b.coef, x);
         let ell = b.ell(rel, &self.values, x);

@@ -74,7 +74,7 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
         let mut subj_of_table: Vec<Option<usize>> = vec![None; t.subjects.len()];
         for i in 0..t.len() {
             match t.gait[i] {
-                Some(g) if g == rel.gait() => {}
+                Some(g) if g == rel.card().gait => {}
                 Some(_) => {
                     p.n_other_gait += 1;
                     continue;
@@ -117,8 +117,8 @@ pub fn prepare(rel: &dyn Relation, tables: &[TrialsTable], weights: Option<&str>
             let row = t.values(i);
             let mut first_err = None;
             let mut used = false;
-            for out in 0..rel.outputs() {
-                match rel.observe_output(&row, out) {
+            for out in 0..rel.card().outputs.len() {
+                match rel.observe(&row, out) {
                     Ok(o) => {
                         // The table's subject id → ours, looked up by name once per id (not
                         // once per row: a string map per row was a fifth of this function).

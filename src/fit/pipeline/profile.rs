@@ -226,7 +226,7 @@ impl Discrete<'_> {
                     "{}: the exact search over partitions stopped after {DISCRETE_MAX_EVALS} \
                      evaluations (the profile is flat over many partitions); the best partition \
                      found is reported",
-                    self.pr.rel.parameters()[self.i].name
+                    self.pr.rel.card().parameters[self.i].name
                 ));
                 break;
             }
@@ -311,7 +311,7 @@ pub(super) fn profile(
 ) -> Result<Vec<f64>, FitError> {
     let rel = pr.rel;
     let bps: Vec<usize> = (0..p0.len())
-        .filter(|&i| pr.lay.free[i] && rel.parameters()[i].kind == ParamKind::Breakpoint)
+        .filter(|&i| pr.lay.free[i] && rel.card().parameters[i].kind == ParamKind::Breakpoint)
         .collect();
     let mut p = p0.to_vec();
     let max_rounds = if bps.len() > 1 { 4 } else { 1 };
@@ -323,10 +323,10 @@ pub(super) fn profile(
                 Some(d) => d
                     .minimise(&p, lo, hi, notes)
                     .ok_or_else(|| FitError::Optimizer {
-                        relation: rel.id().into(),
+                        relation: rel.card().id.into(),
                         message: format!(
                             "no partition of the rows by {} in [{lo}, {hi}] can be fitted",
-                            rel.parameters()[i].name
+                            rel.card().parameters[i].name
                         ),
                     })?,
                 None => {
@@ -603,7 +603,7 @@ pub(super) fn refit(
     let mut free = free.to_vec();
     let mut search = plan.search.clone();
     for i in 0..free.len() {
-        if rel.parameters()[i].kind == ParamKind::Breakpoint && (!free[i] || search[i].is_none()) {
+        if rel.card().parameters[i].kind == ParamKind::Breakpoint && (!free[i] || search[i].is_none()) {
             free[i] = false;
             search[i] = None;
         }

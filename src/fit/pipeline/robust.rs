@@ -41,7 +41,7 @@ pub(super) fn robust_refit(
         y[i] = prep.obs[i].y - off;
     }
     let w = DVector::from_vec(prep.weights.clone());
-    let id = rel.id();
+    let id = rel.card().id;
     let mut problem = LinearProblem::new(&x, &y).named(id);
     if weighted {
         problem = problem.with_weights(&w);
@@ -69,7 +69,7 @@ pub(super) fn robust_refit(
     let tq = t_quantile(0.5 + 0.5 * CONFIDENCE, df);
     let mut rc = Vec::new();
     let mut j = 0;
-    for (i, s) in rel.parameters().iter().enumerate() {
+    for (i, s) in rel.card().parameters.iter().enumerate() {
         if s.kind != ParamKind::Linear {
             continue;
         }

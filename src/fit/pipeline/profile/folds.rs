@@ -442,7 +442,7 @@ mod tests {
                 let r = RunSlV::new(0.1394, 0.00465, 400.0);
                 let y = r.step_length(v, h, level) + 0.03 * (u() - 0.5);
                 p.obs.push(Observation {
-                    x: [v, h, 0.0, 0.0],
+                    x: crate::relations::Inputs::new(&[v, h]),
                     y,
                 });
                 p.subject.push(s);
