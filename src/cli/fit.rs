@@ -41,7 +41,7 @@ under-covers with few or unbalanced subjects (Imbens & Kolesár 2016; Pustejovsk
 2018; measured on the bundled walking data by tools/reference/coverage.py). Each fit record \
 states its method. Breakpoints get the F-based profile confidence set over every \
 admissible value (its pieces and hull); only a regular profile gives them a standard error.\n\n\
-Relations: run-sl-v, run-tflight-sf, run-tflight-sf-continuous, walk-sl-sf, walk-tds-sf, kb-mu \
+Relations: the ids listed under --relation (from the relations registry); kb-mu \
 (Ko & Badler 1993 eqs. 21–24: one observation per μ-function and row, α bounds enforced; r² is \
 pooled with each μ centred on its own mean; per-μ statistics are listed as derived).",
     after_help = "Examples:\n  gaitfit fit                                   # data/*.csv, all relations\n  \
@@ -54,8 +54,9 @@ pub struct Args {
     /// together. Default: every data/*.csv.
     #[arg(long = "data", value_name = "FILE", num_args = 1..)]
     pub data: Vec<PathBuf>,
-    /// Relation id(s) to fit. Default: all (relations with no usable rows are skipped).
-    #[arg(long = "relation", value_name = "ID", num_args = 1..)]
+    /// Relation id(s) to fit (the registry's ids, listed in the help). Default: all (relations
+    /// with no usable rows are skipped).
+    #[arg(long = "relation", value_name = "ID", num_args = 1.., help = relation_help())]
     pub relation: Vec<String>,
     /// Folder for the fit records (JSON and TOML per relation).
     #[arg(long, value_name = "DIR", default_value = "fits")]
@@ -147,6 +148,14 @@ fn load_inputs(paths: &[PathBuf]) -> anyhow::Result<Vec<crate::ingest::trials::T
         }
     }
     Ok(tables)
+}
+
+/// The help of `--relation`: the ids come from the relations registry (one list).
+fn relation_help() -> String {
+    format!(
+        "Relation id(s) to fit: {}. Default: all (relations with no usable rows are skipped)",
+        crate::relations::ids().join(", ")
+    )
 }
 
 /// Runs `gaitfit fit`.

@@ -45,7 +45,7 @@
 //! assert_eq!(r.card().outputs.len(), 4);
 //! ```
 use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::Quantity;
 use std::collections::BTreeMap;

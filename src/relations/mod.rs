@@ -70,7 +70,7 @@ relations! {
 
 pub use run_tflight_sf::Continuity;
 
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::Quantity;
 use std::collections::BTreeMap;

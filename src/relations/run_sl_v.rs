@@ -20,7 +20,7 @@
 //! assert!((r.step_freq(200.0, 1.8, 0.0) - 187.02).abs() < 0.01);
 //! ```
 use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, SubjectEffect, Variable};
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{m_per_s_to_m_per_min, Quantity};
 use std::collections::BTreeMap;

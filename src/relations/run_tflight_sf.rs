@@ -31,7 +31,7 @@
 //! assert!((r.jump_at_k1() - 0.0314).abs() < 0.0005);
 //! ```
 use super::{expect_id, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
 use std::collections::BTreeMap;

@@ -18,7 +18,7 @@
 //! assert!((w.step_length_for_speed(v, 1.8) - 0.7746).abs() < 0.0005);
 //! ```
 use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
 use std::collections::BTreeMap;

@@ -17,7 +17,7 @@
 //! assert!((w.double_support_time(120.0) - 0.0988).abs() < 1e-12);
 //! ```
 use super::{expect_id, linear_gradient, required, Card, Citation, CoefficientSet, Domain, FittedRange, Inputs, Observation, Output, ParamKind, ParameterSpec, Rejection, Relation, RelationError, Variable};
-use crate::events::Gait;
+use crate::gait::Gait;
 use crate::ingest::trials::FieldValues;
 use crate::units::{hz_to_steps_per_min, Quantity};
 use std::collections::BTreeMap;
