@@ -990,7 +990,8 @@ pub fn fit_relation(
         units.insert(e.name.to_string(), e.unit.to_string());
     }
     let valid_range = rel
-        .card().inputs
+        .card()
+        .inputs
         .iter()
         .enumerate()
         .map(|(j, v)| {
@@ -1171,7 +1172,9 @@ pub fn fit_all(
             Err(e @ FitError::TooFew { have: 0, .. }) if skip_missing_gait => run
                 .skipped
                 .push((rel.card().id.to_string(), format!("no usable rows: {e}"))),
-            Err(e) => run.failures.push((rel.card().id.to_string(), e.to_string())),
+            Err(e) => run
+                .failures
+                .push((rel.card().id.to_string(), e.to_string())),
         }
     }
     run

@@ -603,7 +603,9 @@ pub(super) fn refit(
     let mut free = free.to_vec();
     let mut search = plan.search.clone();
     for i in 0..free.len() {
-        if rel.card().parameters[i].kind == ParamKind::Breakpoint && (!free[i] || search[i].is_none()) {
+        if rel.card().parameters[i].kind == ParamKind::Breakpoint
+            && (!free[i] || search[i].is_none())
+        {
             free[i] = false;
             search[i] = None;
         }

@@ -586,7 +586,7 @@ mod tests {
         for i in 0..3000usize {
             let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
             prep.obs.push(Observation {
-                x: [sf, 0.0, 0.0, 0.0],
+                x: crate::relations::Inputs::new(&[sf]),
                 y: 0.1 + 1e-4 * (sf - 200.0) + 1e-3 * ((i % 13) as f64 - 6.0),
             });
             prep.subject.push(i % 4);
