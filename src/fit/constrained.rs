@@ -1,5 +1,5 @@
 //! What the generic pipeline ([`super::pipeline`]) adds for relations with bounded parameters
-//! ([`Relation::bounds`]) or several outputs per row ([`Relation::outputs`]) — today `kb-mu`.
+//! ([`Relation::bounds`]) or several outputs per row ([`Card::outputs`](crate::relations::Card::outputs)) — today `kb-mu`.
 //!
 //! # Bounds
 //! A relation linear in its coefficients with bounds on some of them is a convex quadratic
@@ -12,7 +12,7 @@
 //! standard error is undefined (none is reported); the others' are conditional on it. Folds and
 //! replicates re-solve the bounded problem over every coefficient the data could identify, so a
 //! bound active on all data may be inactive in a fold. Bounds apply to coefficients of the raw
-//! basis (the default [`Relation::basis`]); per-subject effects are not bounded.
+//! basis (the default [`Form::basis`](crate::fit::forms::Form::basis)); per-subject effects are not bounded.
 //!
 //! # Several outputs
 //! Each row gives one observation per output (a μ-function of `kb-mu`). The pooled r² centres

@@ -33,7 +33,7 @@ pub const MAX_BASIS: usize = 16;
 pub struct Layout {
     /// Free-parameter mask (all parameters).
     pub free: Vec<bool>,
-    /// Basis columns ([`Relation::basis_len`]).
+    /// Basis columns ([`Form::basis_len`](crate::fit::forms::Form::basis_len)).
     pub nb: usize,
     /// The basis column absorbed per subject.
     pub subj_col: Option<usize>,

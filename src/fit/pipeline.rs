@@ -5,16 +5,16 @@
 //! # Method
 //! Every relation is linear in its [`ParamKind::Linear`] coefficients once its breakpoints are
 //! fixed (separable least squares), so:
-//! 1. rows are reduced to [`Observation`]s (papers' units); rows lacking a needed quantity,
+//! 1. rows are reduced to [`Observation`](crate::relations::Observation)s (papers' units); rows lacking a needed quantity,
 //!    flagged as inconsistent, or without a usable weight are **rejected and reported** by reason;
-//! 2. [`Relation::plan`] says which coefficients the data can identify; the others are held at
+//! 2. [`Form::plan`](crate::fit::forms::Form::plan) says which coefficients the data can identify; the others are held at
 //!    their published values (and the record says why);
 //! 3. each free breakpoint is **profiled**: the linear coefficients are refitted at each trial
 //!    value and the residual sum of squares minimised (module `profile`: exactly over the
 //!    partitions of the rows for a breakpoint the model depends on only through which rows lie
 //!    on each side, by a grid scan and argmin's Brent method otherwise); two breakpoints are
 //!    profiled by coordinate descent. A breakpoint that marks a feature which may be absent (a
-//!    plateau onset, see [`Relation::breakpoint_null`]) is kept only when an F-test against the
+//!    plateau onset, see [`Form::breakpoint_null`](crate::fit::forms::Form::breakpoint_null)) is kept only when an F-test against the
 //!    model without the feature rejects at 5 %; otherwise it is held at the published value;
 //! 4. at the breakpoints' estimates the linear coefficients come from per-subject sufficient
 //!    statistics ([`super::design`]); a per-subject effect (the running paper's `level`, an

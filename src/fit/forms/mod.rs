@@ -36,7 +36,7 @@ pub struct LinearMap {
 /// at their current (published) value, and the search bracket of each free breakpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
-    /// Per parameter (in [`Relation::parameters`] order): `None` when free, or why it is held.
+    /// Per parameter (in [`Card::parameters`](crate::relations::Card::parameters) order): `None` when free, or why it is held.
     pub held: Vec<Option<String>>,
     /// Per parameter: the search bracket of a free breakpoint (`None` for linear ones).
     pub search: Vec<Option<(f64, f64)>>,

@@ -54,7 +54,7 @@ impl AnkleCurve {
     /// y'(C) = 0, y(D) = a_min, y'(D) = 0` (`γ` = `peak` in `[0, 0.3]`; its peak height follows).
     /// At `γ` = 0.3 it is §4.3's curve with the peak for which `y'(0) = 0`; at `γ = 0` (the
     /// condition at C read as `y''(0) = 0`) it has no peak and falls over all of `D`
-    /// (`a_min + A0·(1 − 4u³ + 3u⁴)`). Used where the reach condition ([`REACH_SHARE`]) leaves
+    /// (`a_min + A0·(1 − 4u³ + 3u⁴)`). Used where the reach condition ([`REACH_SHARE`](super::swing::REACH_SHARE)) leaves
     /// no room for a peak at `0.3·D` (see `reach_curve`).
     pub fn fit_level(x0: f64, d: f64, peak: f64, a0: f64, a_min: f64) -> Option<AnkleCurve> {
         let c = peak * d;
@@ -104,7 +104,7 @@ impl AnkleCurve {
 ///
 /// The root is Newton's from `guess` when it lies on the knee's branch: the ankle residual
 /// `F(θ4) = a_y − P(a_x)` rises with θ4 there (the ankle crosses the curve from below as the knee
-/// flexes: the transversality `sin(φ − ψ)` of [`REACH_SHARE`] is positive) and the root is within
+/// flexes: the transversality `sin(φ − ψ)` of [`REACH_SHARE`](super::swing::REACH_SHARE) is positive) and the root is within
 /// [`KNEE_BRANCH_STEP`] of `guess`. Otherwise, the extremum of `F` next to `guess`
 /// (`∂F/∂θ4 = 0`, where the circle runs parallel to the curve) tells which case it is: where it
 /// is a minimum below zero (or a maximum above), the branch's root lies on its rising side and is
