@@ -207,9 +207,10 @@ fn mean_sd(v: &[f64]) -> String {
     mean_sd_prec(v, 3)
 }
 
-fn mean_sd_prec(v: &[f64], digits: usize) -> String {
+/// Mean and sample SD of `v` (SD 0 for one value; `None` when empty).
+fn mean_and_sd(v: &[f64]) -> Option<(f64, f64)> {
     if v.is_empty() {
-        return "–".into();
+        return None;
     }
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
@@ -218,7 +219,14 @@ fn mean_sd_prec(v: &[f64], digits: usize) -> String {
     } else {
         0.0
     };
-    format!("{m:.digits$}±{sd:.digits$}")
+    Some((m, sd))
+}
+
+fn mean_sd_prec(v: &[f64], digits: usize) -> String {
+    mean_and_sd(v).map_or_else(
+        || "–".into(),
+        |(m, sd)| format!("{m:.digits$}±{sd:.digits$}"),
+    )
 }
 
 fn summary(results: &[TrialResult]) -> String {
@@ -300,17 +308,7 @@ fn print_reference_disagreement(results: &[TrialResult]) {
 
 /// `+m.m ± s.s` of `v` (`–` when empty).
 fn mean_sd_signed(v: &[f64]) -> String {
-    if v.is_empty() {
-        return "–".into();
-    }
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let sd = if v.len() > 1 {
-        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
-    } else {
-        0.0
-    };
-    format!("{m:+.1} ± {sd:.1}")
+    mean_and_sd(v).map_or_else(|| "–".into(), |(m, sd)| format!("{m:+.1} ± {sd:.1}"))
 }
 
 /// Runs `gaitfit events`.
