@@ -498,10 +498,10 @@ pub(super) fn solve_sorted(
     members: Members,
     remove: Option<(f64, f64)>,
 ) -> Option<(DVector<f64>, f64)> {
+    let mut t = Totals::zeros(lay.m());
     match lay.subj_col {
         // A per-subject column: each subject's normal equations, that column absorbed, summed.
         Some(_) => {
-            let mut t = Totals::zeros(lay.m());
             for (s, mult) in members.list(sr.subj.len()) {
                 let one = [(s, 1.0)];
                 let q = Query {
@@ -509,16 +509,8 @@ pub(super) fn solve_sorted(
                     members: Members::List(&one),
                     remove,
                 };
-                let ne = sr
-                    .ctx
-                    .form
-                    .normal_equations(p, &lay.free, &sr.ctx.scale, &q);
-                if ne.nb != lay.nb {
-                    return None;
-                }
-                t.add(&SubjectSums::absorb(&ne, lay.subj_col)?, mult);
+                t.add(&absorbed(&q, p, lay)?, mult);
             }
-            t.solve(lay)
         }
         None => {
             let q = Query {
@@ -526,18 +518,23 @@ pub(super) fn solve_sorted(
                 members,
                 remove,
             };
-            let ne = sr
-                .ctx
-                .form
-                .normal_equations(p, &lay.free, &sr.ctx.scale, &q);
-            if ne.nb != lay.nb {
-                return None;
-            }
-            let mut t = Totals::zeros(lay.m());
-            t.add(&SubjectSums::absorb(&ne, None)?, 1.0);
-            t.solve(lay)
+            t.add(&absorbed(&q, p, lay)?, 1.0);
         }
     }
+    t.solve(lay)
+}
+
+/// The normal equations of the rows `q` selects, with the per-subject column (if any) absorbed;
+/// `None` when the form's basis does not have the layout's size.
+fn absorbed(q: &Query, p: &[f64], lay: &Layout) -> Option<SubjectSums> {
+    let ne =
+        q.sr.ctx
+            .form
+            .normal_equations(p, &lay.free, &q.sr.ctx.scale, q);
+    if ne.nb != lay.nb {
+        return None;
+    }
+    SubjectSums::absorb(&ne, lay.subj_col)
 }
 
 #[cfg(test)]
