@@ -54,7 +54,7 @@ use super::stats::{
     aic, bic, bootstrap_by_group, leave_one_group_out, r2_centred, r2_uncentred, t_quantile, TTest,
 };
 use super::FitError;
-use crate::fit::forms::Fitting;
+use crate::fit::forms::{DistinctKeys, Fitting};
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Fitted, Inputs, ParamKind, Relation};
 use profile::{
@@ -202,7 +202,7 @@ pub fn fit_relation(
         Some(sr) => Source::Sorted {
             sr,
             members: Members::All,
-            keys: &all_keys,
+            keys: DistinctKeys::new(&all_keys),
         },
         None => Source::Rows {
             prep: &prep,
@@ -212,7 +212,7 @@ pub fn fit_relation(
         },
     };
     let plan = match &sorted {
-        Some(sr) => sr.form().plan_sorted(&all_keys),
+        Some(sr) => sr.form().plan_sorted(DistinctKeys::new(&all_keys)),
         None => rel.plan(&prep.obs),
     };
     let mut free: Vec<bool> = plan.held.iter().map(|h| h.is_none()).collect();

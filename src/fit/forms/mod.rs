@@ -226,12 +226,77 @@ pub trait SortedProfile: Sync {
     ) -> NormalEquations;
     /// [`Fitting::plan`] from the distinct keys of the rows, ascending (the relation's
     /// `plan` must equal this applied to its observations' keys).
-    fn plan_sorted(&self, keys: &[f64]) -> Plan;
+    fn plan_sorted(&self, keys: DistinctKeys) -> Plan;
     /// True when the model depends on breakpoint `i` only through which rows fall on each side
     /// of it (the residual sum of squares is then constant between adjacent keys, and the
     /// search runs over those partitions exactly).
     fn discrete_breakpoint(&self, _i: usize) -> bool {
         false
+    }
+}
+
+/// Distinct keys, ascending, seen as a sorted list without some of its positions: a
+/// leave-one-subject-out fold's keys are all rows' keys without those only the left-out subject
+/// has, so no fold copies the (up to n) keys. Indexing and [`partition_point`](Self::partition_point)
+/// are O(log) in the number of skipped positions.
+#[derive(Debug, Clone, Copy)]
+pub struct DistinctKeys<'a> {
+    all: &'a [f64],
+    /// Positions in `all` left out, strictly ascending.
+    skip: &'a [u32],
+}
+
+impl<'a> DistinctKeys<'a> {
+    /// Every key of `all` (distinct, ascending).
+    pub fn new(all: &'a [f64]) -> DistinctKeys<'a> {
+        DistinctKeys { all, skip: &[] }
+    }
+    /// The keys of `all` but those at positions `skip` (strictly ascending).
+    pub fn without(all: &'a [f64], skip: &'a [u32]) -> DistinctKeys<'a> {
+        debug_assert!(skip.windows(2).all(|w| w[0] < w[1]));
+        debug_assert!(skip.last().is_none_or(|&j| (j as usize) < all.len()));
+        DistinctKeys { all, skip }
+    }
+    /// Number of keys.
+    pub fn len(&self) -> usize {
+        self.all.len() - self.skip.len()
+    }
+    /// True when there is no key.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// The `j`-th key (ascending). Panics when `j ≥ len()`, as slice indexing does.
+    pub fn get(&self, j: usize) -> f64 {
+        // Skipped positions before the j-th kept one: those e_k with e_k − k ≤ j (e_k − k, the
+        // kept positions before e_k, is non-decreasing in k).
+        let (mut lo, mut hi) = (0, self.skip.len());
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if self.skip[mid] as usize - mid <= j {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        assert!(j < self.len(), "key {j} of {}", self.len());
+        self.all[j + lo]
+    }
+    /// The number of keys for which `pred` holds, `pred` being true on a prefix (as
+    /// [`slice::partition_point`]).
+    pub fn partition_point(&self, pred: impl FnMut(&f64) -> bool) -> usize {
+        let f = self.all.partition_point(pred);
+        f - self.skip.partition_point(|&e| (e as usize) < f)
+    }
+    /// The keys, copied.
+    pub fn to_vec(&self) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.len());
+        let mut from = 0;
+        for &j in self.skip {
+            out.extend_from_slice(&self.all[from..j as usize]);
+            from = j as usize + 1;
+        }
+        out.extend_from_slice(&self.all[from..]);
+        out
     }
 }
 
@@ -504,5 +569,48 @@ pub(crate) mod sorted_check {
             ne.yty,
             want.yty
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DistinctKeys;
+
+    #[test]
+    fn a_view_without_positions_indexes_and_searches_like_the_copied_keys() {
+        let all: Vec<f64> = (0..40).map(|i| 100.0 + 1.5 * i as f64).collect();
+        let skips: [&[u32]; 5] = [
+            &[],
+            &[0],
+            &[39],
+            &[0, 1, 2, 17, 18, 38, 39],
+            &[5, 9, 10, 11, 30],
+        ];
+        for skip in skips {
+            let view = DistinctKeys::without(&all, skip);
+            let copy: Vec<f64> = all
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| !skip.contains(&(*j as u32)))
+                .map(|(_, &k)| k)
+                .collect();
+            assert_eq!(view.len(), copy.len());
+            assert_eq!(view.to_vec(), copy);
+            for (j, &k) in copy.iter().enumerate() {
+                assert_eq!(view.get(j), k, "skip {skip:?}, key {j}");
+            }
+            for t in [90.0, 100.0, 100.5, 113.5, 125.0, 158.5, 200.0] {
+                assert_eq!(
+                    view.partition_point(|&k| k < t),
+                    copy.partition_point(|&k| k < t),
+                    "skip {skip:?}, < {t}"
+                );
+                assert_eq!(
+                    view.partition_point(|&k| k <= t),
+                    copy.partition_point(|&k| k <= t),
+                    "skip {skip:?}, <= {t}"
+                );
+            }
+        }
     }
 }

@@ -1,6 +1,9 @@
 //! The fit form of `run-sl-v` (running 1996, eq. 2): the plateau onset v_norm is profiled over
 //! the height-normalised speed u = v/√(h/1.8) with sorted prefix sums of a few per-row features.
-use super::{sorted_keys, Form, KeyRange, KeyScale, KeySums, NormalEquations, Plan, SortedProfile};
+use super::{
+    sorted_keys, DistinctKeys, Form, KeyRange, KeyScale, KeySums, NormalEquations, Plan,
+    SortedProfile,
+};
 use crate::relations::run_sl_v::REFERENCE_HEIGHT_M;
 use crate::relations::{Observation, Relation};
 
@@ -10,7 +13,7 @@ pub struct SlVForm;
 
 impl Form for SlVForm {
     fn plan(&self, _rel: &dyn Relation, obs: &[Observation]) -> Plan {
-        self.plan_sorted(&sorted_keys(self, obs))
+        self.plan_sorted(DistinctKeys::new(&sorted_keys(self, obs)))
     }
     fn sorted_profile(&self) -> Option<&dyn SortedProfile> {
         Some(self)
@@ -83,10 +86,10 @@ impl SortedProfile for SlVForm {
         };
         NormalEquations::hold_raw(&raw, &free[..2], &p[..2])
     }
-    fn plan_sorted(&self, u: &[f64]) -> Plan {
+    fn plan_sorted(&self, u: DistinctKeys) -> Plan {
         // At least 3 distinct normalised speeds on each side of any trial breakpoint.
         let (held, search) = if u.len() >= 8 {
-            (None, Some((u[2], u[u.len() - 3])))
+            (None, Some((u.get(2), u.get(u.len() - 3))))
         } else {
             (
                 Some(format!(

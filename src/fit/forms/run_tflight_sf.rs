@@ -5,8 +5,8 @@
 //! continuous variant fits with quadratic(k1) = cubic(k1) built into the basis (q0 determined by
 //! the others). The knots k1, k2 are profiled with sorted prefix sums of the moments of sf.
 use super::{
-    sorted_keys, FeatureSums, Form, KeyRange, KeyScale, KeySums, LinearMap, NormalEquations, Plan,
-    SortedProfile,
+    sorted_keys, DistinctKeys, FeatureSums, Form, KeyRange, KeyScale, KeySums, LinearMap,
+    NormalEquations, Plan, SortedProfile,
 };
 use crate::relations::run_tflight_sf::{cubic, quad, tflight};
 use crate::relations::{Continuity, Inputs, Observation, Relation, RunTflightSf};
@@ -95,7 +95,7 @@ fn centred_to_raw(deg: usize, m: f64, s: f64) -> DMatrix<f64> {
 
 impl Form for TflightForm {
     fn plan(&self, _rel: &dyn Relation, obs: &[Observation]) -> Plan {
-        self.plan_sorted(&sorted_keys(self, obs))
+        self.plan_sorted(DistinctKeys::new(&sorted_keys(self, obs)))
     }
 
     fn sorted_profile(&self) -> Option<&dyn SortedProfile> {
@@ -554,27 +554,27 @@ impl SortedProfile for TflightForm {
         }
         ne
     }
-    fn plan_sorted(&self, d: &[f64]) -> Plan {
+    fn plan_sorted(&self, d: DistinctKeys) -> Plan {
         let p = published();
         let (k1, k2) = (p[7], p[8]);
-        let below: Vec<f64> = d.iter().copied().filter(|&s| s < k1).collect();
-        let mid: Vec<f64> = d.iter().copied().filter(|&s| s >= k1 && s <= k2).collect();
-        let above: Vec<f64> = d.iter().copied().filter(|&s| s > k2).collect();
+        // Counts from positions in the sorted keys (a fold's keys are not copied).
+        let n_below = d.partition_point(|&s| s < k1);
+        let n_to_k2 = d.partition_point(|&s| s <= k2);
+        let n_mid = n_to_k2.saturating_sub(n_below);
+        let n_above = d.len() - n_to_k2;
         let mut held: Vec<Option<String>> = vec![None; 9];
         let mut search = vec![None; 9];
-        if below.len() < MIN_DISTINCT {
+        if n_below < MIN_DISTINCT {
             let why = format!(
-                "held at the published value: {} distinct step frequencies below k1 = {k1} (need {MIN_DISTINCT})",
-                below.len()
+                "held at the published value: {n_below} distinct step frequencies below k1 = {k1} (need {MIN_DISTINCT})"
             );
             for h in held.iter_mut().take(3) {
                 *h = Some(why.clone());
             }
         }
-        if mid.len() < MIN_DISTINCT {
+        if n_mid < MIN_DISTINCT {
             let why = format!(
-                "held at the published value: {} distinct step frequencies in [k1, k2] = [{k1}, {k2}] (need {MIN_DISTINCT})",
-                mid.len()
+                "held at the published value: {n_mid} distinct step frequencies in [k1, k2] = [{k1}, {k2}] (need {MIN_DISTINCT})"
             );
             for h in held.iter_mut().take(7).skip(3) {
                 *h = Some(why.clone());
@@ -582,10 +582,10 @@ impl SortedProfile for TflightForm {
         }
         let n = d.len();
         if held[0].is_none() && held[3].is_none() && n >= 2 * MIN_DISTINCT {
-            let lo = d[MIN_DISTINCT - 1];
-            let hi_candidates: Vec<f64> = d.iter().copied().filter(|&s| s <= k2).collect();
-            let hi = if hi_candidates.len() >= MIN_DISTINCT {
-                hi_candidates[hi_candidates.len() - MIN_DISTINCT]
+            let lo = d.get(MIN_DISTINCT - 1);
+            // The keys ≤ k2 are the first n_to_k2.
+            let hi = if n_to_k2 >= MIN_DISTINCT {
+                d.get(n_to_k2 - MIN_DISTINCT)
             } else {
                 lo
             };
@@ -599,17 +599,17 @@ impl SortedProfile for TflightForm {
                     .to_string(),
             );
         }
-        if held[3].is_none() && above.len() >= 3 && mid.len() >= MIN_DISTINCT {
-            let lo = mid[mid.len().min(MIN_DISTINCT) - 1].max(k1 + 1.0);
-            let hi = d[n - 3];
+        if held[3].is_none() && n_above >= 3 && n_mid >= MIN_DISTINCT {
+            // The keys in [k1, k2] are positions n_below..n_to_k2.
+            let lo = d.get(n_below + n_mid.min(MIN_DISTINCT) - 1).max(k1 + 1.0);
+            let hi = d.get(n - 3);
             if hi > lo {
                 search[8] = Some((lo, hi));
             }
         }
         if search[8].is_none() {
             held[8] = Some(format!(
-                "held at the published value: {} distinct step frequencies above k2 = {k2} (need 3) — the plateau is not in the data",
-                above.len()
+                "held at the published value: {n_above} distinct step frequencies above k2 = {k2} (need 3) — the plateau is not in the data"
             ));
         }
         Plan { held, search }
@@ -737,7 +737,7 @@ mod tests {
             })
             .collect();
         let keys = sorted_keys(form, &obs);
-        assert_eq!(r.plan(&obs), form.plan_sorted(&keys));
+        assert_eq!(r.plan(&obs), form.plan_sorted(DistinctKeys::new(&keys)));
         assert!(r.plan(&obs).search[7].is_some() && r.plan(&obs).search[8].is_some());
     }
 }

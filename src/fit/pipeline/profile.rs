@@ -29,7 +29,7 @@
 //! - Two breakpoints are profiled by coordinate descent.
 use super::Prepared;
 use crate::fit::design::{solve_rows, Layout};
-use crate::fit::forms::Fitting;
+use crate::fit::forms::{DistinctKeys, Fitting};
 use crate::fit::nonlinear::minimize_1d;
 use crate::fit::prec::MIN1D_GRID;
 use crate::fit::record::BreakpointRecord;
@@ -64,7 +64,7 @@ pub(super) enum Source<'b> {
     Sorted {
         sr: &'b SortedRows<'b>,
         members: Members<'b>,
-        keys: &'b [f64],
+        keys: DistinctKeys<'b>,
     },
     /// All subjects but `s`, from the folds' shared sums (module `folds`).
     Fold {
@@ -129,7 +129,7 @@ struct Discrete<'b> {
     pr: &'b Profiler<'b>,
     sr: &'b SortedRows<'b>,
     members: Members<'b>,
-    keys: &'b [f64],
+    keys: DistinctKeys<'b>,
     i: usize,
 }
 
@@ -151,7 +151,7 @@ impl Ord for Ordered {
 impl Discrete<'_> {
     /// The breakpoint value representing partition `j`: the middle of its gap.
     fn value(&self, j: usize) -> f64 {
-        0.5 * (self.keys[j - 1] + self.keys[j])
+        0.5 * (self.keys.get(j - 1) + self.keys.get(j))
     }
     fn rss(&self, p: &[f64], j: usize) -> f64 {
         self.pr.rss_at(p, self.i, self.value(j))
@@ -166,7 +166,7 @@ impl Discrete<'_> {
             self.pr.lay,
             &q,
             self.members,
-            Some((self.keys[a], self.keys[b])),
+            Some((self.keys.get(a), self.keys.get(b))),
         )
         // Singular without those rows: no bound.
         .map_or(0.0, |r| r.1)
@@ -277,8 +277,8 @@ impl Discrete<'_> {
             // Partition j holds every value in (keys[j − 1], keys[j]].
             let (a, b) = (accepted[k].0, accepted[e].0);
             pieces.push([
-                (a > j0).then(|| self.keys[a - 1]),
-                (b < j1).then(|| self.keys[b]),
+                (a > j0).then(|| self.keys.get(a - 1)),
+                (b < j1).then(|| self.keys.get(b)),
             ]);
             for q in k..=e {
                 let r = accepted[q].1;
@@ -577,12 +577,13 @@ pub(super) fn refit(
     subset: Subset,
 ) -> Option<Vec<f64>> {
     let (plan, n_subj, map, keys);
+    let own_keys;
     match subset {
         Subset::Rows(prep, rows) => {
             let (m, n) = dense_subjects(prep, rows);
             let sub_obs: Vec<Observation> = rows.iter().map(|&i| prep.obs[i]).collect();
             plan = rel.plan(&sub_obs);
-            (n_subj, map, keys) = (n, m, Vec::new());
+            (n_subj, map, keys) = (n, m, DistinctKeys::new(&[]));
         }
         Subset::Subjects(sr, members) => {
             let list = members.list(sr.subj.len());
@@ -590,13 +591,14 @@ pub(super) fn refit(
             for &(s, _) in &list {
                 include[s] = true;
             }
-            keys = sr.distinct_keys(&include);
-            plan = sr.ctx.form.plan_sorted(&keys);
+            own_keys = sr.distinct_keys(&include);
+            keys = DistinctKeys::new(&own_keys);
+            plan = sr.ctx.form.plan_sorted(keys);
             (n_subj, map) = (list.len(), Vec::new());
         }
         Subset::Fold(sr, fk, _, s) => {
             keys = fk.without(s);
-            plan = sr.ctx.form.plan_sorted(&keys);
+            plan = sr.ctx.form.plan_sorted(keys);
             (n_subj, map) = (sr.subj.len() - 1, Vec::new());
         }
     }
@@ -618,18 +620,14 @@ pub(super) fn refit(
             subj_map: Some(&map),
             n_subj,
         },
-        Subset::Subjects(sr, members) => Source::Sorted {
-            sr,
-            members,
-            keys: &keys,
-        },
+        Subset::Subjects(sr, members) => Source::Sorted { sr, members, keys },
         Subset::Fold(sr, _, engine, s) => {
             match engine.filter(|e| e.applies(&lay, p_start, &search)) {
                 Some(engine) => Source::Fold { engine, s },
                 None => Source::Sorted {
                     sr,
                     members: Members::AllBut(s),
-                    keys: &keys,
+                    keys,
                 },
             }
         }

@@ -30,6 +30,7 @@
 //!   subjects directly.
 use super::{Members, Query, SortedRows};
 use crate::fit::design::{Layout, SubjectSums, Totals};
+use crate::fit::forms::DistinctKeys;
 use crate::fit::prec::MIN1D_GRID;
 use nalgebra::DVector;
 use std::collections::HashMap;
@@ -80,17 +81,9 @@ impl FoldKeys {
         FoldKeys { keys, own }
     }
 
-    /// The distinct keys of all rows but subject `s`'s.
-    pub fn without(&self, s: usize) -> Vec<f64> {
-        let own = &self.own[s];
-        let mut out = Vec::with_capacity(self.keys.len() - own.len());
-        let mut from = 0;
-        for &j in own {
-            out.extend_from_slice(&self.keys[from..j as usize]);
-            from = j as usize + 1;
-        }
-        out.extend_from_slice(&self.keys[from..]);
-        out
+    /// The distinct keys of all rows but subject `s`'s (a view: nothing is copied).
+    pub fn without(&self, s: usize) -> DistinctKeys<'_> {
+        DistinctKeys::without(&self.keys, &self.own[s])
     }
 }
 
@@ -469,7 +462,11 @@ mod tests {
         let fk = FoldKeys::new(&sr);
         for s in 0..7 {
             let include: Vec<bool> = (0..7).map(|x| x != s).collect();
-            assert_eq!(fk.without(s), sr.distinct_keys(&include), "subject {s}");
+            assert_eq!(
+                fk.without(s).to_vec(),
+                sr.distinct_keys(&include),
+                "subject {s}"
+            );
         }
     }
 
