@@ -196,44 +196,47 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     } else {
         None
     };
-    let run = fit_all(&relations, &tables, &opts, args.relation.is_empty(), |id| {
-        if let Some(b) = &bar {
-            b.set_message(id.to_string());
-            b.inc(1);
+    // One relation at a time, its files written as soon as it is fitted; without reports, only
+    // its record is kept (the rows, fitted values and residuals of a relation are dropped before
+    // the next is fitted, so memory holds one relation's working set, not all of them).
+    let mut run = crate::fit::pipeline::FitRun::default();
+    let mut records = Vec::new();
+    let mut lines = Vec::new();
+    for rel in &relations {
+        let one = fit_all(
+            std::slice::from_ref(rel),
+            &tables,
+            &opts,
+            args.relation.is_empty(),
+            |id| {
+                if let Some(b) = &bar {
+                    b.set_message(id.to_string());
+                    b.inc(1);
+                }
+            },
+        );
+        for o in one.outcomes {
+            write_fit_files(&args.fits, &o.record)?;
+            lines.push(summary_line(&o, &args.fits));
+            if args.no_report {
+                records.push(o.record);
+            } else {
+                run.outcomes.push(o);
+            }
         }
-    });
+        run.failures.extend(one.failures);
+        run.skipped.extend(one.skipped);
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    for o in &run.outcomes {
-        write_fit_files(&args.fits, &o.record)?;
-        let r = &o.record;
-        let unit = r
-            .units
-            .get(o.refit.card().response.symbol)
-            .cloned()
-            .unwrap_or_default();
-        // Ko–Badler's α have no published values: its "published" curve is a reference.
-        let against = if crate::report::summary::reference_words(r).is_some() {
-            "paper's reference curve"
-        } else {
-            "published"
-        };
-        println!(
-            "{}: n = {}, r² = {:.4} ({against} {:.4}), rmse = {:.4} {} → {}",
-            r.relation,
-            r.n,
-            r.r2,
-            r.published_fit.r2,
-            r.rmse,
-            unit,
-            args.fits.join(format!("{}.json", r.relation)).display()
-        );
+    for l in &lines {
+        println!("{l}");
     }
-    let few: Vec<String> = run
-        .outcomes
+    let few: Vec<String> = records
         .iter()
-        .filter_map(|o| o.record.inference.as_ref().map(|i| (&o.record.relation, i)))
+        .chain(run.outcomes.iter().map(|o| &o.record))
+        .filter_map(|r| r.inference.as_ref().map(|i| (&r.relation, i)))
         .filter(|(_, i)| i.method == "CR1" && i.clusters < CR2_RECOMMENDED_BELOW)
         .map(|(r, i)| format!("{r} ({})", i.clusters))
         .collect();
@@ -258,9 +261,36 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             args.reports.display()
         );
     }
-    Ok(if run.failures.is_empty() && !run.outcomes.is_empty() {
+    let fitted = !records.is_empty() || !run.outcomes.is_empty();
+    Ok(if run.failures.is_empty() && fitted {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
     })
+}
+
+/// The line `gaitfit fit` prints for a fitted relation.
+fn summary_line(o: &crate::fit::pipeline::FitOutcome, fits: &std::path::Path) -> String {
+    let r = &o.record;
+    let unit = r
+        .units
+        .get(o.refit.card().response.symbol)
+        .cloned()
+        .unwrap_or_default();
+    // Ko–Badler's α have no published values: its "published" curve is a reference.
+    let against = if crate::report::summary::reference_words(r).is_some() {
+        "paper's reference curve"
+    } else {
+        "published"
+    };
+    format!(
+        "{}: n = {}, r² = {:.4} ({against} {:.4}), rmse = {:.4} {} → {}",
+        r.relation,
+        r.n,
+        r.r2,
+        r.published_fit.r2,
+        r.rmse,
+        unit,
+        fits.join(format!("{}.json", r.relation)).display()
+    )
 }
