@@ -109,6 +109,38 @@ impl RunReport {
     }
 }
 
+/// The note for a step where recovery 3 (§3.3.1) inserted knee flexion: which foot, by how much
+/// it would have missed its ground clearance, and the cause. In a running step the pelvis sinks
+/// from touchdown to mid-support by what the commanded bounciness (stance knee flexion at
+/// mid-support) requires, and the swing leg's joint-angle track passes under it. In the start
+/// from a stand (no sink) the swing track leaves the standing pose with the foot on the ground.
+fn clearance_note(index: usize, r: &state::StepReport) -> String {
+    let foot = if r.clearance_hind {
+        "hind foot (after toe off)"
+    } else {
+        "swing foot"
+    };
+    if r.pelvis_sink <= 0.0 {
+        return format!(
+            "step {index} (start from a stand): the {foot}'s joint-angle track from the standing \
+             pose would have passed {:.0} mm lower than its ground clearance; RUNNER's recovery 3 \
+             (§3.3.1) flexed the knee more at {} control point(s)",
+            1000.0 * r.clearance_deficit,
+            r.clearance_keys
+        );
+    }
+    format!(
+        "step {index}: the {foot} would have passed {:.0} mm lower than its ground clearance \
+         because the pelvis sinks {:.1} cm from touchdown to mid-support for the commanded \
+         bounciness (stance knee {:.0}° at mid-support); RUNNER's recovery 3 (§3.3.1) flexed \
+         the knee more at {} control point(s)",
+        1000.0 * r.clearance_deficit,
+        100.0 * r.pelvis_sink,
+        r.bounciness.to_degrees(),
+        r.clearance_keys
+    )
+}
+
 /// Estimated time from a stop request to standing still, s.
 fn stop_duration_estimate(params: &RunParams) -> f64 {
     let fr = (params.body_height / 1.8).sqrt();
@@ -233,10 +265,7 @@ pub fn generate_run(
             ));
         }
         if r.clearance_keys > 0 {
-            notes.push(format!(
-                "step {}: foot stubbing, {} control point(s) with more knee flexion inserted",
-                s.index, r.clearance_keys
-            ));
+            notes.push(clearance_note(s.index, r));
         }
         if r.out_of_reach {
             notes.push(format!(

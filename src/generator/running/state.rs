@@ -238,6 +238,18 @@ pub struct StepReport {
     pub mid_support_lowered: u32,
     /// Control points inserted to clear the ground with the swing or flight legs (recovery 3).
     pub clearance_keys: u32,
+    /// How far below its required clearance a foot would have passed without recovery 3, m
+    /// (the worst of the toe-off keyframe, the swing leg and the hind leg; 0 if none).
+    pub clearance_deficit: f64,
+    /// Which leg needed the most recovery 3: `true` the hind leg (after toe off), `false` the
+    /// swing leg.
+    pub clearance_hind: bool,
+    /// Pelvis drop from touchdown to the mid-support control point, m (what the commanded
+    /// bounciness, the stance knee flexion at mid-support, makes the pelvis sink); 0 for the
+    /// start from a stand, whose pelvis rises straight to toe off.
+    pub pelvis_sink: f64,
+    /// The stance knee flexion at mid-support this step was planned with (the bounciness), rad.
+    pub bounciness: f64,
     /// The stance hip stayed out of reach somewhere despite recovery 1.
     pub out_of_reach: bool,
     /// Overstride of the landing that ends the step, m (the attribute, or more for a long

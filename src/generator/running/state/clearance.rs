@@ -38,7 +38,8 @@ pub(super) fn required_clearance(
 /// Checks a swinging foot's clearance on a track over [t_a, t_b] and, where it stubs the
 /// ground, adds a temporary knee flexion peaking at the worst instant (§3.3.1's recovery:
 /// "inserts a new control point with temporarily increased knee flexion"), raised until the
-/// foot clears. Returns the number of raises.
+/// foot clears. Returns the number of raises and the deficit before the first (m, 0 if the
+/// foot cleared).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn clear_track(
     plan: &mut StepPlan,
@@ -50,7 +51,7 @@ pub(super) fn clear_track(
     ramp_in: bool,
     ramp_out: bool,
     margin: f64,
-) -> u32 {
+) -> (u32, f64) {
     let n = 40;
     let worst = |plan: &StepPlan| {
         let track = if hind { &plan.hind } else { &plan.swing };
@@ -71,8 +72,9 @@ pub(super) fn clear_track(
     };
     let (deficit, t_worst) = worst(plan);
     if deficit <= 0.0 {
-        return 0;
+        return (0, 0.0);
     }
+    let first = deficit;
     // The bump's peak is kept off the window's ends so the extra flexion builds up smoothly.
     // A held bump (hind leg) may peak after the window: the next step inherits its value and
     // rate.
@@ -100,5 +102,5 @@ pub(super) fn clear_track(
         raises += 1;
         deficit = worst(plan).0;
     }
-    raises
+    (raises, first)
 }

@@ -223,6 +223,12 @@ pub fn plan_step(
         plan.report.mid_support_lowered += 1;
     }
 
+    // From a stand the pelvis rises straight to toe off: no mid-support sink.
+    if kind != StepKind::Start {
+        plan.report.pelvis_sink = p0.y - y_ms;
+    }
+    plan.report.bounciness = e.bounciness;
+
     // --- Toe-off pose of the stance leg and its rates (start of the hind leg's flight). ---
     let (to_pose, to_rate, to_hip_ankle) = stance_state(&plan, d, t_stance);
     plan.arm_back.1 = to_hip_ankle;
@@ -301,6 +307,10 @@ pub fn plan_step(
     // applied to the keyframe itself, so the flight starts from a clear foot.
     let hip_tor = hip_of(&plan, d, t_stance, -s);
     let need = TOR_CLEARANCE * d.body_height / 1.8;
+    let tor_deficit = need - leg_fk(d, hip_tor, &tor_pose).lowest();
+    if tor_deficit > 0.0 {
+        plan.report.clearance_deficit = tor_deficit;
+    }
     while leg_fk(d, hip_tor, &tor_pose).lowest() < need && tor_pose.pitch < 100f64.to_radians() {
         tor_pose.pitch += 2f64.to_radians();
         tor_pose.knee = toe_under_knee(d, tor_pose.pitch, tor_pose.ankle);
@@ -427,10 +437,19 @@ pub fn plan_step(
     let margin = 0.01 * d.body_height / 1.8;
     let start = kind == StepKind::Start;
     let t_sw0 = plan.swing.start();
-    plan.report.clearance_keys +=
-        clear_track(&mut plan, d, sw, false, t_sw0, t_step, start, true, margin);
-    plan.report.clearance_keys +=
-        clear_track(&mut plan, d, s, true, t_stance, t_step, true, false, margin);
+    for (sign, hind, t_a, ramp_in, ramp_out) in [
+        (sw, false, t_sw0, start, true),
+        (s, true, t_stance, true, false),
+    ] {
+        let (keys, deficit) = clear_track(
+            &mut plan, d, sign, hind, t_a, t_step, ramp_in, ramp_out, margin,
+        );
+        plan.report.clearance_keys += keys;
+        if deficit > plan.report.clearance_deficit {
+            plan.report.clearance_deficit = deficit;
+            plan.report.clearance_hind = hind;
+        }
+    }
     Ok(plan)
 }
 
