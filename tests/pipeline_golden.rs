@@ -61,6 +61,7 @@ fn refitting_bundled_data_reproduces_committed_fits() {
                     "CR2" => Some(SeMethod::Cr2),
                     _ => None,
                 }),
+            random_subject: committed.random_subject.is_some(),
         };
         let now = fit_relation(rel.as_ref(), &tables, &opts).unwrap().record;
         assert_eq!(now.n, committed.n, "{}", committed.relation);

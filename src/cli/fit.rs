@@ -85,6 +85,11 @@ pub struct Args {
     /// where CR1 under-covers), or `iid` (rows independent; the default with one subject).
     #[arg(long, value_enum, value_name = "METHOD")]
     pub se: Option<SeArg>,
+    /// Also fit a random-intercept model by REML (subjects' levels as random effects, Gaussian)
+    /// for the linear relations (walk-sl-sf, walk-tds-sf) and record its fixed effects and
+    /// variance components beside least squares (checked against statsmodels MixedLM).
+    #[arg(long)]
+    pub random_subject: bool,
     /// Do not write reports/ (plots and summary).
     #[arg(long)]
     pub no_report: bool,
@@ -184,6 +189,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         }),
         seed: args.seed,
         se: args.se.map(SeMethod::from),
+        random_subject: args.random_subject,
     };
     let bar = if std::io::stderr().is_terminal() {
         let b = indicatif::ProgressBar::new(relations.len() as u64);

@@ -11,6 +11,7 @@
 //! - [`design`]: the linear part at fixed breakpoints from per-subject sufficient statistics
 //!   (per-subject effects absorbed), the normal-equation solve, covariances;
 //! - [`inference`]: iid, cluster-robust CR1 and CR2 (Bell–McCaffrey) standard errors;
+//! - [`mixed`]: the random-intercept model by REML (`--random-subject`);
 //! - [`stats`]: quantiles, LRE, r², AIC/BIC, leave-one-group-out and the seeded group bootstrap;
 //! - [`prec`]: every named tolerance of the fitting layer in one place;
 //! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
@@ -21,6 +22,7 @@ pub mod constrained;
 pub mod design;
 pub mod forms;
 pub mod inference;
+pub mod mixed;
 pub mod nonlinear;
 pub mod ols;
 pub mod pipeline;

@@ -101,6 +101,8 @@ pub struct FitOptions {
     /// Bell–McCaffrey degrees of freedom below [`CR2_RECOMMENDED_BELOW`] subjects, CR1 from
     /// there on — else iid.
     pub se: Option<SeMethod>,
+    /// Also fit the random-intercept model by REML ([`super::mixed`]).
+    pub random_subject: bool,
 }
 
 impl FitOptions {
@@ -889,6 +891,9 @@ pub fn fit_relation(
         None => (r2, r2_def, adj_r2, pub_r2),
     };
 
+    let random_subject = opts
+        .random_subject
+        .then(|| super::mixed::random_subject_record(rel, &prep, &p, weighted));
     // Robust refit.
     let robust = if opts.robust {
         Some(robust_refit(
@@ -1106,6 +1111,7 @@ pub fn fit_relation(
         weights: opts.weights.clone(),
         robust,
         bootstrap,
+        random_subject: random_subject.and_then(|r| r.map_err(|why| notes.push(why)).ok()),
         notes,
     };
     // The refit knows the range it was fitted on (predictions beyond it hold the boundary).

@@ -248,6 +248,39 @@ pub struct RobustRecord {
     pub coefficients: Vec<CoefficientRecord>,
 }
 
+/// A random-intercept mixed model fitted by REML (`--random-subject`): the fixed effects with
+/// their model-based standard errors, and the two variance components.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MixedRecord {
+    /// The model and how it was fitted.
+    pub method: String,
+    /// Fixed effects: value, standard error from `σ̂_e² (XᵀV̂⁻¹X)⁻¹`, normal 95 % interval.
+    pub coefficients: Vec<MixedCoefficient>,
+    /// Between-subject standard deviation `σ̂_u` (response unit).
+    pub subject_sd: f64,
+    /// Within-subject (residual) standard deviation `σ̂_e`.
+    pub residual_sd: f64,
+    /// Intraclass correlation `σ̂_u² / (σ̂_u² + σ̂_e²)`.
+    pub icc: f64,
+    /// Restricted log-likelihood at the estimate.
+    pub reml_log_likelihood: f64,
+}
+
+/// A fixed effect of a [`MixedRecord`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MixedCoefficient {
+    /// Name (as in [`FitRecord::coefficients`]).
+    pub name: String,
+    /// Unit.
+    pub unit: String,
+    /// Estimate.
+    pub value: f64,
+    /// Standard error.
+    pub std_error: f64,
+    /// Normal (z) 95 % interval `[lo, hi]`.
+    pub ci95: [f64; 2],
+}
+
 /// The bootstrap settings and outcome.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BootstrapRecord {
@@ -335,6 +368,9 @@ pub struct FitRecord {
     /// Bootstrap (`--bootstrap N --seed S`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bootstrap: Option<BootstrapRecord>,
+    /// Random-intercept REML model (`--random-subject`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub random_subject: Option<MixedRecord>,
     /// Notes a reader should see (held coefficients, flagged subjects, r² definition).
     pub notes: Vec<String>,
 }
