@@ -273,11 +273,13 @@ fn ko_badler_lines_have_per_output_variances_and_checked_bounded_solves() {
     assert!(cr1.loso_rmse.is_some());
 }
 
-/// Huber (`--robust`): the M-estimate, its scale and Huber's H1 sandwich standard errors against
-/// statsmodels RLM (`tools/reference/robust.json`, made by `tools/reference/robust.py`:
-/// `RLM(y, X, M=HuberT(1.345)).fit(scale_est='mad', cov='H1')` on the same rows).
+/// Huber (`--robust`): the M-estimate, its scale and Huber's H1 sandwich standard errors (with
+/// `--se iid`) against statsmodels RLM, and the clustered CR1 sandwich (the default with several
+/// subjects) against numpy from RLM's own residuals, scale and ψ (`tools/reference/robust.json`,
+/// made by `tools/reference/robust.py`: `RLM(y, X, M=HuberT(1.345)).fit(scale_est='mad',
+/// cov='H1')` on the same rows).
 #[test]
-fn huber_standard_errors_match_statsmodels_rlm_h1() {
+fn huber_standard_errors_match_statsmodels_rlm_h1_and_the_clustered_sandwich() {
     let p = root().join("tools/reference/robust.json");
     let want: Value =
         serde_json::from_str(&std::fs::read_to_string(&p).expect("reference file")).expect("json");
@@ -287,34 +289,52 @@ fn huber_standard_errors_match_statsmodels_rlm_h1() {
         ("walk-sl-sf", &["k"][..]),
     ] {
         let w = &want[id];
-        let opts = FitOptions {
-            robust: true,
-            ..FitOptions::default()
-        };
-        let rel = by_id(id).expect("relation");
-        let rec = fit_relation(rel.as_ref(), &tables, &opts)
-            .expect("fit")
-            .record;
-        assert_eq!(rec.n as f64, num(&w["n"]), "{id} rows");
-        let rob = rec.robust.as_ref().expect("robust record");
-        assert!(rob.converged, "{id}: IRLS did not converge");
-        close(rob.scale, num(&w["scale"]), 1e-6, &format!("{id} scale"));
-        assert_eq!(rob.rows_downweighted as f64, num(&w["rows_downweighted"]));
-        let coefs = nums(&w["coef"]);
-        let ses = nums(&w["se_h1"]);
-        for (j, name) in names.iter().enumerate() {
-            let c = rob
-                .coefficients
-                .iter()
-                .find(|c| c.name == *name)
-                .expect("robust coefficient");
-            close(c.value, coefs[j], 1e-6, &format!("{id} {name}"));
-            close(
-                c.std_error.expect("robust se"),
-                ses[j],
-                1e-6,
-                &format!("{id} {name} H1 se"),
-            );
+        // Rows independent: H1 (statsmodels RLM). Clustered (the default with several
+        // subjects, and --se cluster): the M-estimator's CR1 sandwich by subject, computed in
+        // the script from RLM's residuals, scale and ψ.
+        for (se, key, df) in [
+            (SeMethod::Iid, "se_h1", None),
+            (SeMethod::Cluster, "se_cr1", Some(num(&w["clusters"]) - 1.0)),
+            (SeMethod::Cr2, "se_cr1", Some(num(&w["clusters"]) - 1.0)),
+        ] {
+            let opts = FitOptions {
+                robust: true,
+                se: Some(se),
+                ..FitOptions::default()
+            };
+            let rel = by_id(id).expect("relation");
+            let rec = fit_relation(rel.as_ref(), &tables, &opts)
+                .expect("fit")
+                .record;
+            assert_eq!(rec.n as f64, num(&w["n"]), "{id} rows");
+            let rob = rec.robust.as_ref().expect("robust record");
+            assert!(rob.converged, "{id}: IRLS did not converge");
+            close(rob.scale, num(&w["scale"]), 1e-6, &format!("{id} scale"));
+            assert_eq!(rob.rows_downweighted as f64, num(&w["rows_downweighted"]));
+            let how = rob.cov.as_deref().expect("cov text");
+            assert_eq!(how.contains("by subject (CR1"), df.is_some(), "{id}: {how}");
+            let coefs = nums(&w["coef"]);
+            let ses = nums(&w[key]);
+            for (j, name) in names.iter().enumerate() {
+                let c = rob
+                    .coefficients
+                    .iter()
+                    .find(|c| c.name == *name)
+                    .expect("robust coefficient");
+                close(c.value, coefs[j], 1e-6, &format!("{id} {name}"));
+                let se_got = c.std_error.expect("robust se");
+                close(se_got, ses[j], 1e-6, &format!("{id} {name} {key}"));
+                if let Some(df) = df {
+                    let [lo, hi] = c.ci95;
+                    let t = gaitfit::fit::stats::t_quantile(0.975, df);
+                    close(
+                        hi.expect("hi") - lo.expect("lo"),
+                        2.0 * t * ses[j],
+                        1e-6,
+                        &format!("{id} {name} interval width (t, {df} df)"),
+                    );
+                }
+            }
         }
     }
 }

@@ -64,7 +64,9 @@ pub struct Args {
     /// Folder for plots and summary.md.
     #[arg(long, value_name = "DIR", default_value = "reports")]
     pub reports: PathBuf,
-    /// Also fit a Huber robust M-estimate (IRLS, k = 1.345) and report it beside least squares.
+    /// Also fit a Huber robust M-estimate (IRLS, k = 1.345) and report it beside least squares;
+    /// its standard errors are the cluster-robust M-estimator sandwich by subject (CR1, t with
+    /// G − 1 df) when the fit clusters, Huber's H1 (statsmodels RLM) with `--se iid`.
     #[arg(long)]
     pub robust: bool,
     /// Weighted least squares with weights (inverse variances, > 0) from this column.

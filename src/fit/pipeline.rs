@@ -905,6 +905,7 @@ pub fn fit_relation(
             &held_reason,
             &published,
             weighted,
+            method,
         )?)
     } else {
         None
