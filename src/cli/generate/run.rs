@@ -30,7 +30,9 @@ pub struct Args {
     /// Step frequency: `187/min`, `3.1Hz` (bare: steps/min).
     #[arg(long = "step-freq", value_name = "FREQ", value_parser = freq_arg)]
     pub step_freq: Option<f64>,
-    /// Flight height H (eq. 3): `0.004m`, `4mm` (bare: m). The flight time then follows from H.
+    /// Flight height H (eq. 3): `0.004m`, `4mm` (bare: m). The flight time then follows from H;
+    /// with speed and step length both given this is the paper's case II, and where one H gives
+    /// two flight times the one nearest eq. 5's is used and the other is printed in a note.
     #[arg(long = "flight-height", value_name = "LENGTH", value_parser = length_arg)]
     pub flight_height: Option<f64>,
     /// Expertise level, −1 (poor) … 1 (skilled) (scaled to the paper's ±0.001 in eq. 2 and

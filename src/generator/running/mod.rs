@@ -256,6 +256,7 @@ pub fn generate_run(
         .filter(|s| s.start_s <= end && (scheduled_stop || end_step.is_none_or(|k| s.index < k)))
         .collect();
     let mut notes = Vec::new();
+    let mut ambiguous_noted = false;
     for s in &steps {
         let r = &s.report;
         if r.mid_support_lowered > 0 {
@@ -263,6 +264,20 @@ pub fn generate_run(
                 "step {}: hip too high, mid-support control point lowered {} time(s)",
                 s.index, r.mid_support_lowered
             ));
+        }
+        if let Some(t_other) = r.other_flight_time {
+            if !ambiguous_noted {
+                ambiguous_noted = true;
+                notes.push(format!(
+                    "step {}: flight height H = {:.4} m is reached with a flight of {:.3} s and of \
+                     {t_other:.3} s (eq. 3 with eqs. 7–8); {} is used, here and in every later \
+                     step with two flight times",
+                    s.index,
+                    r.flight_height,
+                    r.t_flight,
+                    state::keyframes::CASE_TWO_RULE
+                ));
+            }
         }
         if r.clearance_keys > 0 {
             notes.push(clearance_note(s.index, r));

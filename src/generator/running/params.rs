@@ -116,7 +116,10 @@ impl RunParams {
     /// The flight specification a step is planned with.
     pub fn flight_spec(&self) -> FlightSpec {
         if self.flight_from_height {
-            FlightSpec::Height(self.flight_height)
+            FlightSpec::Height {
+                height: self.flight_height,
+                near: self.flight_time,
+            }
         } else {
             FlightSpec::Time(self.flight_time)
         }
@@ -246,7 +249,7 @@ impl RunModel {
         attrs: &RunAttributes,
     ) -> Result<(f64, f64), GenerateError> {
         let h_guess = match flight {
-            FlightSpec::Height(h) => h,
+            FlightSpec::Height { height, .. } => height,
             FlightSpec::Time(_) => super::attributes::H_REF * self.dims.body_height / 1.8,
         };
         // Bounciness (the only H-coupled attribute) does not enter eq. 3, so any H will do here.
@@ -293,7 +296,9 @@ impl RunModel {
         }
         let (h, t_f, flight_from_height) = match from_h {
             Some(h) => {
-                let (_, t_f) = self.steady_flight(v, sl, sf, FlightSpec::Height(h), attrs)?;
+                let near = self.relations.flight_time(sf, base.level);
+                let spec = FlightSpec::Height { height: h, near };
+                let (_, t_f) = self.steady_flight(v, sl, sf, spec, attrs)?;
                 (h, t_f, true)
             }
             None => {

@@ -47,7 +47,14 @@ pub enum FlightSpec {
     /// Case I: the flight time (s) is known (from eqs. 4–5); H follows from eq. 3.
     Time(f64),
     /// Case II: the flight height H (m) is known; the flight time follows from eqs. 3, 7, 8.
-    Height(f64),
+    /// Eq. 3 with eqs. 7–8 has, in general, two flight times for one H; the one nearest `near`
+    /// (s) is used ([`keyframes::CASE_TWO_RULE`]).
+    Height {
+        /// Flight height H, m.
+        height: f64,
+        /// The flight time to choose by: the flight-time relation's (eq. 5), s.
+        near: f64,
+    },
 }
 
 /// Which of the two cases of §3.2 produced a step's toe-off pelvis.
@@ -229,6 +236,9 @@ pub struct StepReport {
     pub t_stance: f64,
     /// Flight height by eq. 3, m.
     pub flight_height: f64,
+    /// Case II: the other flight time that gives the same flight height, s (see
+    /// [`keyframes::CASE_TWO_RULE`]); `None` for case I or a single root.
+    pub other_flight_time: Option<f64>,
     /// Vertical pelvis velocity at toe off, m/s (negative: no apex, eq. 3 then reports the
     /// height of the mirrored apex).
     pub takeoff_vy: f64,

@@ -1,6 +1,8 @@
 //! The state keyframes of one step (§3.2): the toe-off leg length of eq. 8, the pelvis at toe
-//! off by case I (flight time given, eqs. 7–8) or case II (flight height given, 2-D
-//! Newton–Raphson on eqs. 3 and 8), the landing built bottom-up, and the flight time and height.
+//! off by case I (flight time given, eqs. 7–8) or case II (flight height given: every flight
+//! time that gives H bracketed along eqs. 7–8, the one nearest eq. 5's chosen by
+//! [`CASE_TWO_RULE`], then the paper's 2-D Newton–Raphson on eqs. 3 and 8), the landing built
+//! bottom-up, and the flight time and height.
 use super::*;
 
 pub(super) fn numerical(stage: &str, message: String) -> GenerateError {
@@ -115,6 +117,59 @@ fn solve_case_two(problem: CaseTwo, guess: (f64, f64)) -> Result<(f64, f64), Gen
     Ok((p[0], p[1]))
 }
 
+/// Case II's rule when eq. 3 gives several flight times for one flight height H: the one nearest
+/// the flight-time relation's (eq. 5 at the step frequency) is used. Along the toe-off leg's
+/// circle (eqs. 7–8) H(t) is large at short flights (the pelvis must climb from a low toe off in
+/// little time), falls to a minimum and grows again with the ballistic g·t/2, so an H above the
+/// minimum is reached twice, and which root is the runner's differs: at 2.5 m/s and 1.6 m the
+/// published relation's 0.189 s flight is the long root (the other is 0.029 s), while with the
+/// refitted `fits/` at 3 m/s the measured 0.080 s is the short one (the other 0.196 s). With this
+/// rule case I at eq. 5's flight time and case II at the H it gives return the same flight time
+/// (`tests/run_case_two.rs`).
+pub const CASE_TWO_RULE: &str = "the flight time nearest the flight-time relation's (eq. 5)";
+
+/// Every flight time t in (0, `t_max`] at which eq. 3's unsquared form, g·t/2 − (y1(t) − y2)/t =
+/// √(2gH), holds, ascending; `y1(t)` is the toe-off pelvis height of case I (eqs. 7–8), `None`
+/// where the toe-off leg cannot reach. A scan of 400 intervals brackets the sign changes, then
+/// bisection to 1e-12 s.
+pub(super) fn case_two_flight_times(
+    y1: impl Fn(f64) -> Option<f64>,
+    y2: f64,
+    h: f64,
+    t_max: f64,
+) -> Vec<f64> {
+    let w = (2.0 * G * h).sqrt();
+    let r = |t: f64| y1(t).map(|y| 0.5 * G * t - (y - y2) / t - w);
+    let n = 400;
+    let mut roots = Vec::new();
+    let mut prev: Option<(f64, f64)> = None;
+    for i in 1..=n {
+        let t = t_max * i as f64 / n as f64;
+        let cur = r(t).map(|v| (t, v));
+        if let (Some((ta, ra)), Some((tb, rb))) = (prev, cur) {
+            if ra == 0.0 {
+                roots.push(ta);
+            } else if ra * rb < 0.0 {
+                let (mut lo, mut hi, mut rlo) = (ta, tb, ra);
+                while hi - lo > 1e-12 {
+                    let mid = 0.5 * (lo + hi);
+                    match r(mid) {
+                        Some(rm) if rm * rlo > 0.0 => {
+                            lo = mid;
+                            rlo = rm;
+                        }
+                        Some(_) => hi = mid,
+                        None => break,
+                    }
+                }
+                roots.push(0.5 * (lo + hi));
+            }
+        }
+        prev = cur;
+    }
+    roots
+}
+
 /// Least support time as a fraction of the step. Eqs. 4–5 never ask for less (published: ≥ 26 %
 /// up to 25 km/h and +10 % step frequency), but a refitted eq. 5 extrapolated beyond its data
 /// can (0.231 s of flight in a 0.243 s step), and the legs then whirl through the support;
@@ -144,6 +199,9 @@ pub struct StateKeys {
     pub t_flight: f64,
     /// Support time, s.
     pub t_stance: f64,
+    /// Case II only: the next flight time that gives the same flight height (eq. 3 has, in
+    /// general, two; [`CASE_TWO_RULE`] chose `t_flight`), s; `None` for case I or one root.
+    pub other_flight_time: Option<f64>,
     /// Flight height by eq. 3, m.
     pub flight_height: f64,
     /// Vertical take-off velocity, m/s.
@@ -242,8 +300,15 @@ pub fn state_keyframes(
     // ahead (the attribute stays the least overstride) until the pelvis takes off no lower than
     // it lands (the take-off of an unforced flight), or the toe-off leg leans no more than
     // TOE_OFF_LEAN_MAX; the published relations never lean it further (≤ 26° over 2–25 km/h).
+    // Case II plans the landing for the flight time it chooses by (`near`, the relation's), so
+    // that case I at a flight time and case II at the H it gives plan the same step.
     let mut os = e.overstride;
-    if let FlightSpec::Time(t_f) = inp.flight {
+    let planned_flight = match inp.flight {
+        FlightSpec::Time(t_f) => t_f,
+        FlightSpec::Height { near, .. } => near,
+    };
+    {
+        let t_f = planned_flight;
         let gap = |os: f64| match landing(os) {
             Err(_) => f64::INFINITY,
             Ok((_, x2, y2)) => match case_one(x2, t_f) {
@@ -269,14 +334,37 @@ pub fn state_keyframes(
         }
     }
     let (next_print, x2, y2) = landing(os)?;
+    let mut other_flight_time = None;
     let (x1, y1, t_flight, case) = match inp.flight {
         FlightSpec::Time(t_f) => {
             let (x1, y1) = case_one(x2, t_f)?;
             (x1, y1, t_f, FlightCase::I)
         }
-        FlightSpec::Height(h) => {
-            let guess_t = 0.5 * t_step;
-            let (gx, gy) = case_one(x2, guess_t).unwrap_or((x2 - v * guess_t, rad * 0.99));
+        FlightSpec::Height { height: h, near } => {
+            // Eq. 3 with eqs. 7–8 has, in general, two flight times for one H (H(t) falls from
+            // the take-off's height difference at short flights and rises with the ballistic
+            // g·t/2 at long ones): all are found along case I's toe-off pelvis, the shortest is
+            // used by `CASE_TWO_RULE` (nearest the flight-time relation's) and the nearest other
+            // one is reported. Newton–Raphson then refines it, as the paper solves case II.
+            let t_max = (1.0 - MIN_STANCE_FRACTION) * t_step;
+            let roots =
+                case_two_flight_times(|t| case_one(x2, t).ok().map(|(_, y1)| y1), y2, h, t_max);
+            let by_distance = |t: &f64| (t - near).abs();
+            let mut sorted = roots.clone();
+            sorted.sort_by(|a, b| by_distance(a).total_cmp(&by_distance(b)));
+            let Some(&guess_t) = sorted.first() else {
+                return Err(numerical(
+                    "case II",
+                    format!(
+                        "no flight time up to {t_max:.3} s (a support of at least {:.0} % of the \
+                         step) gives flight height H = {h} m at v = {v:.3} m/s, sl = {sl:.3} m; \
+                         lower H or unlock the step frequency",
+                        MIN_STANCE_FRACTION * 100.0
+                    ),
+                ));
+            };
+            other_flight_time = sorted.get(1).copied();
+            let (gx, gy) = case_one(x2, guess_t)?;
             let (x1, y1) = solve_case_two(
                 CaseTwo {
                     rad,
@@ -320,6 +408,7 @@ pub fn state_keyframes(
         w,
         rad,
         case,
+        other_flight_time,
         o2,
         yaw1,
         yaw2,
@@ -379,7 +468,10 @@ mod tests {
         let one = plan_step(&d, &inp, &carry, StepKind::Normal).unwrap();
         let h = one.report.flight_height;
         let inp2 = StepInput {
-            flight: FlightSpec::Height(h),
+            flight: FlightSpec::Height {
+                height: h,
+                near: 0.188,
+            },
             ..inp
         };
         let two = plan_step(&d, &inp2, &carry, StepKind::Normal).unwrap();

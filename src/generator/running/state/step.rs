@@ -71,6 +71,7 @@ pub fn plan_step(
         w,
         rad,
         case,
+        other_flight_time,
         o2,
         yaw1,
         yaw2,
@@ -152,6 +153,7 @@ pub fn plan_step(
         stop: StopPath::default(),
         report: StepReport {
             case: Some(case),
+            other_flight_time,
             p1,
             p2,
             t_flight,
