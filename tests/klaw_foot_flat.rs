@@ -73,6 +73,11 @@ fn heel_hover(kmh: f64, h: f64) -> (f64, i64, usize, [f64; 2]) {
 /// length with twice its reach off the rest length (`generate::SLOW_REST_REACH`): 0.00/0.02/0.09
 /// mm, the heel rising at 33–36 % of the cycle. Every speed is asserted now.
 ///
+/// Since the stance simulation locks at the paper's `l1` (no reach of the drawn leg in it) and
+/// the drawing lowers the pelvis where the flat foot is out of the drawn leg's soft reach
+/// (`draw::PelvisDrop`, issue 20 stage A): the highest heel 0.10–0.26 mm at every walk here, the
+/// heel rising (1 mm) at 38–43 % of the cycle.
+///
 /// Since the heel-off event is where the drawn heel leaves the floor (≈ 0.2 mm of roll,
 /// `generate::drawn_heel_off`; before, the rule's switch, 1–46 frames earlier), the highest heel
 /// up to the frame before it is 0.07–0.25 mm at every one of these walks (the figures above

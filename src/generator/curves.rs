@@ -96,6 +96,14 @@ pub fn smoothstep(s: f64) -> f64 {
     s * s * (3.0 - 2.0 * s)
 }
 
+/// `6s⁵ − 15s⁴ + 10s³` on [0, 1] (clamped): a C² blend (zero rate and acceleration at both
+/// ends).
+#[inline]
+pub fn smootherstep(s: f64) -> f64 {
+    let s = s.clamp(0.0, 1.0);
+    s * s * s * (s * (6.0 * s - 15.0) + 10.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

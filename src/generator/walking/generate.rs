@@ -15,7 +15,6 @@ use super::stop::{Closing, StopStart};
 use super::swing::{SwingCarry, SwingSpec, SwingStart};
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg, KNEE_SOFT, TOE_OFF_KNEE_RATE};
 use crate::events::Side;
-use crate::generator::curves::smoothstep;
 use crate::generator::motion::Motion;
 use crate::generator::skeleton::Skeleton;
 use crate::generator::GenerateError;
@@ -98,47 +97,6 @@ impl WalkReport {
 
 fn num_err(stage: String, message: String) -> GenerateError {
     GenerateError::Numerical { stage, message }
-}
-
-/// How many times the projected reach (`StanceSpec::flat_reach`) the leg spring's rest length is
-/// shortened by in the slowest walks (Froude speed `v/√(g·l1)` up to [`SLOW_REST_FROUDE`]`[0]`),
-/// blending (smoothstep in Froude) to once the reach at [`SLOW_REST_FROUDE`]`[1]` and above.
-pub const SLOW_REST_REACH: f64 = 2.0;
-
-/// Froude speeds between which [`SLOW_REST_REACH`] blends to once the reach (see there).
-pub const SLOW_REST_FROUDE: [f64; 2] = [0.14, 0.20];
-
-/// Froude speed below which a stance that locks at the projected length
-/// ([`PROJECTED_LOCK_FROUDE_MAX`]) also shortens its leg spring's rest length by the reach
-/// ([`SLOW_REST_REACH`] × it in the slowest walks) (`StanceSpec::rest_reach`, ramped in over the
-/// first 20 % of the stance and out from its middle: `stance::REST_RAMP_IN`/`REST_RAMP_OUT`).
-pub const REST_SHORTENING_FROUDE_MAX: f64 = 0.24;
-
-/// Froude speed up to which the stance leg locks at the projected length (≈ 7 km/h at 2.0 m).
-pub const PROJECTED_LOCK_FROUDE_MAX: f64 = 0.65;
-
-/// Whether a stance at `speed` m/s of a body with unloaded leg `l1` locks at the sagittal
-/// projection of the drawn leg (below [`PROJECTED_LOCK_FROUDE_MAX`]): not on the first step from
-/// standing (`from_rest`), nor on the last before a stop (`to_rest`) at or above
-/// [`REST_SHORTENING_FROUDE_MAX`], whose own rules keep their measured landings (see
-/// [`edge_lock`]).
-fn projected_lock(speed: f64, l1: f64, from_rest: bool, to_rest: bool) -> bool {
-    let froude = super::stance::froude_speed(speed, l1);
-    !from_rest && (!to_rest || edge_lock(froude)) && froude < PROJECTED_LOCK_FROUDE_MAX
-}
-
-/// The weight of the slowest walks' settings ([`SLOW_REST_REACH`],
-/// [`super::stance::REST_RAMP_IN_SLOW`]) at Froude speed `froude`: 1 up to
-/// [`SLOW_REST_FROUDE`]`[0]`, 0 from [`SLOW_REST_FROUDE`]`[1]`, a smoothstep between.
-fn slowness(froude: f64) -> f64 {
-    let [lo, hi] = SLOW_REST_FROUDE;
-    smoothstep(((hi - froude) / (hi - lo)).clamp(0.0, 1.0))
-}
-
-/// Whether the last stance before a stop locks at the projected length (and shortens its rest
-/// length) like the walk's: in slow walks (Froude below [`REST_SHORTENING_FROUDE_MAX`]).
-fn edge_lock(froude: f64) -> bool {
-    froude < REST_SHORTENING_FROUDE_MAX
 }
 
 /// Shortest meta-off knee flexion, as a fraction of the double support (see
@@ -275,6 +233,7 @@ pub fn generate_steps(
     }
     let mut stance_guess = [0.0, 0.0];
     let mut stance_jac = None;
+
     let mut swing_guess = [0.0; 7];
     let mut swing_carry = SwingCarry::default();
     let mut recovery_by_leg = [0.0f64; 2];
@@ -374,47 +333,10 @@ pub fn generate_steps(
                 super::stance::push_off_exponent(l.speed_m_per_s, body.l1)
             },
             lock_short: 0.0,
-            lock_reach: 0.0,
-            flat_reach: 0.0,
-            rest_reach: 0.0,
-            rest_ramp_in: super::stance::REST_RAMP_IN,
         };
         // At speed the leg locks short of l1: the midstance knee (`stance::lock_shortening`).
         let lock_short = super::stance::lock_shortening(spec.push_off);
-        // The rigid leg is the sagittal projection of the drawn 3-D leg, whose hip is `dz` beside
-        // the stance foot, with the virtual leg's soft knee (flat only up to 2·KNEE_SOFT short of
-        // straight): the stance heel stays down through midstance (`StanceSpec::lock_length`).
-        // The largest `dz` of the stance (sampled; its peak is at midstance, in the lock).
-        let zf_lock = side_z(stance_side, a);
-        let dz_max = (0..=32)
-            .map(|i| {
-                let t = t_step * i as f64 / 32.0;
-                (det.lateral_at(t) - det.swing_offset(t).z - zf_lock).abs()
-            })
-            .fold(0.0, f64::max);
-        let lock_full = body.l1 * (1.0 - lock_short);
-        let lock_flat = lock_full - 2.0 * KNEE_SOFT - STAND_MARGIN;
-        let flat_reach = lock_full - (lock_flat * lock_flat - dz_max * dz_max).max(0.0).sqrt();
-        // Where the lock is not shortened by it, the drawn knee takes it (`drawn_span`); in
-        // slow walks the spring's rest length is shortened by it as well
-        // (`REST_SHORTENING_FROUDE_MAX`).
-        let projected = projected_lock(l.speed_m_per_s, body.l1, from_rest, to_rest);
-        let froude = super::stance::froude_speed(l.speed_m_per_s, body.l1);
-        let slow = froude < REST_SHORTENING_FROUDE_MAX;
-        let spec = StanceSpec {
-            lock_short,
-            lock_reach: if projected { flat_reach } else { 0.0 },
-            flat_reach,
-            rest_reach: if projected && slow {
-                flat_reach * (1.0 + (SLOW_REST_REACH - 1.0) * slowness(froude))
-            } else {
-                0.0
-            },
-            rest_ramp_in: super::stance::REST_RAMP_IN
-                + (super::stance::REST_RAMP_IN_SLOW - super::stance::REST_RAMP_IN)
-                    * slowness(froude),
-            ..spec
-        };
+        let spec = StanceSpec { lock_short, ..spec };
         let (st_solved, st_run) = spec
             .solve_with(&stance_start, stance_guess, stance_jac)
             .map_err(|e| num_err(stage("stance shooting"), e))?;
@@ -429,6 +351,73 @@ pub fn generate_steps(
             h.pos[1] += body.l9;
             h
         };
+        // The simulated hips of the stance and the trailing leg (sagittal x, y; lateral z).
+        let stance_hip_sim = |t: f64| -> ([f64; 2], f64) {
+            let h = dyn_hip(t);
+            let o = det.swing_offset(t);
+            let z_c = det.lateral_at(t);
+            ([h.pos[0] - o.x, h.pos[1]], z_c - o.z)
+        };
+        // The drawn pelvis is lowered where the flat stance foot is out of the drawn leg's soft
+        // reach (`draw::PelvisDrop`): this stance's drop is the largest its flat foot needs
+        // while the simulated leg is not extending (the extension beyond the lock is the heel
+        // rising, §4.2), blended in from the previous stance's over the double support.
+        let span_max = spec.drawn_span(&st_run, body.l3 + body.l4);
+        let zf_s = side_z(stance_side, a);
+        let flat_reach = span_max.min(body.l3 + body.l4) - 2.0 * KNEE_SOFT - STAND_MARGIN;
+        let need = |t: f64| {
+            let (hp, hz) = stance_hip_sim(t);
+            flat_drop(hp, hz - zf_s, [ax, body.l9], flat_reach)
+        };
+        // From the hip's closest approach to the flat ankle (the need's least: the foot cannot
+        // be flat before) to the extension.
+        let t_flat_end = st_run.extend_time.unwrap_or(0.5 * t_step).min(t_step);
+        let needs: Vec<f64> = (0..=64)
+            .map(|i| need(t_flat_end * i as f64 / 64.0))
+            .collect();
+        let closest = (0..needs.len()).fold(0, |m, i| if needs[i] < needs[m] { i } else { m });
+        let drop_to = needs[closest..].iter().copied().fold(0.0, f64::max);
+        // The drop rises as slowly as still covers the need, with the soft knee's width to
+        // spare, from the closest approach on (where the foot can first be flat).
+        let covers = |rise: f64| {
+            let p = PelvisDrop {
+                height: drop_to,
+                rise,
+                fall: t_flat_end,
+                end: t_step,
+            };
+            (closest..needs.len()).all(|i| {
+                let need = (needs[i] + KNEE_SOFT).min(drop_to);
+                p.at(t_flat_end * i as f64 / 64.0) >= need - 1e-6
+            })
+        };
+        // The largest rise that covers (bisection: the drop's rise is continuous in the need).
+        let (mut lo, mut hi) = (t_flat_end * closest.max(8) as f64 / 64.0, t_flat_end);
+        if covers(hi) {
+            lo = hi;
+        }
+        while hi - lo > 1e-6 {
+            let mid = 0.5 * (lo + hi);
+            if covers(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let rise = lo;
+        let drop = PelvisDrop {
+            height: drop_to,
+            rise,
+            fall: t_flat_end,
+            end: t_step,
+        };
+        let stance_hip = |t: f64| -> ([f64; 2], f64) {
+            let (hp, hz) = stance_hip_sim(t);
+            ([hp[0], hp[1] - drop.at(t)], hz)
+        };
+        // The swing leg hangs from the drawn pelvis, as from the kinematic pelvic rotation and
+        // list (§2: the determinants are injected into the one-hip model): the simulated hip with
+        // the determinants' offsets and the drop.
         let swing_hip = |t: f64| -> HipMotion {
             let mut h = dyn_hip(t);
             let (o, od, odd) = det.swing_hip_offset_rates(t);
@@ -437,18 +426,23 @@ pub fn generate_steps(
                 h.vel[i] += od[i];
                 h.acc[i] += odd[i];
             }
+            let [d, dd, ddd] = drop.rates(t);
+            h.pos[1] -= d;
+            h.vel[1] -= dd;
+            h.acc[1] -= ddd;
             h
-        };
-        let stance_hip = |t: f64| -> ([f64; 2], f64) {
-            let h = dyn_hip(t);
-            let o = det.swing_offset(t);
-            let z_c = det.lateral_at(t);
-            ([h.pos[0] - o.x, h.pos[1]], z_c - o.z)
         };
         let swing_hip3 = |t: f64| -> ([f64; 2], f64) {
             let h = swing_hip(t);
             let o = det.swing_offset(t);
             (h.pos, det.lateral_at(t) + o.z)
+        };
+        // The trailing leg's rules see the simulated hip: its foot is off flat, and the drop
+        // rising under it through the double support would bend its knee and then roll the foot
+        // (the drawn leg reaches the rule's ankle from the lowered pelvis all the same).
+        let trail_hip3 = |t: f64| -> ([f64; 2], f64) {
+            let (hp, hz) = swing_hip3(t);
+            ([hp[0], hp[1] + drop.at(t)], hz)
         };
         // 2. The trailing leg completes its stance through the double support.
         let dt_v = 2e-3;
@@ -477,7 +471,7 @@ pub fn generate_steps(
             || (speeds_up(&all, kk) && trailing.period == FootPeriod::HeelOff))
             && trailing.period != FootPeriod::MetaOff
         {
-            let (hp, hz) = swing_hip3(0.0);
+            let (hp, hz) = trail_hip3(0.0);
             let knee = trailing.pose_at(hp, hz - zf_w, trailing.rho).knee;
             trailing.period = FootPeriod::MetaOff;
             trailing.meta_start = Some((trailing_clock, knee));
@@ -487,7 +481,7 @@ pub fn generate_steps(
                 let hips: Vec<(f64, [f64; 2], f64)> = (0..=n_v)
                     .map(|i| {
                         let t = t_ds * i as f64 / n_v as f64;
-                        let (hp, hz) = swing_hip3(t);
+                        let (hp, hz) = trail_hip3(t);
                         (trailing_clock + t, hp, hz - zf_w)
                     })
                     .collect();
@@ -498,11 +492,12 @@ pub fn generate_steps(
         let mut trail_poses: Vec<(f64, LegPose, [f64; 2])> = Vec::with_capacity(n_v + 1);
         for i in 0..=n_v {
             let t = t_ds * i as f64 / n_v as f64;
-            let (hp, hz) = swing_hip3(t);
+            let (hp, hz) = trail_hip3(t);
             let p = trailing.advance(trailing_clock + t, hp, hz - zf_w);
             trail_rho.push((t, p.rho));
             trail_hips.push((hp, hz - zf_w));
-            trail_poses.push((t, p, hp));
+            // The swing starts from the drawn (lowered) hip it hangs from.
+            trail_poses.push((t, p, swing_hip3(t).0));
         }
         let trail_leg = trailing.clone();
         // Toe-off state: the sagittal thigh and knee angles of the hip–ankle chain (so the swing
@@ -530,12 +525,11 @@ pub fn generate_steps(
             .map(|nl| phase_times(nl.step_freq_steps_per_min, &opt.relations));
         stance_leg.toe_off_knee_rate = toe_off_rate(kk + 1);
         // The knee keeps the locked leg's midstance flexion (see `StanceSpec::drawn_span`).
-        stance_leg.span_max = spec.drawn_span(&st_run, stance_leg.l3 + stance_leg.l4);
+        stance_leg.span_max = span_max;
         stance_leg.toe_off_time = t_step
             + next_times
                 .map(|t| t.double_support)
                 .unwrap_or(times.double_support);
-        let zf_s = side_z(stance_side, a);
         let n_s = ((t_step / dt_v).ceil() as usize).max(2);
         let hips: Vec<(f64, [f64; 2], f64)> = (0..=n_s)
             .map(|i| {
@@ -715,6 +709,7 @@ pub fn generate_steps(
             trail_hips,
             trail_leg,
             trail_origin: t_global - trailing_clock,
+            drop,
         });
         if recorded {
             t_end = t_global + t_step;

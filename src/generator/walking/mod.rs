@@ -21,10 +21,12 @@
 //!
 //! **Continuity caveat.** Steady walks of 1–7 km/h × 1.5–2.0 m meet the smoothness check
 //! [`crate::generator::checks::continuity`] at k = 5 (every frame-to-frame step within 5 × the
-//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.29 steady
-//! (the ankle at every heel strike), 5.56 from standing with a stop, and on a 0.1 km/h × 5 cm
-//! grid 6.7–7.0 km/h × 1.5–1.6 m (5.04–5.29) and 3.3 km/h × 1.55 m (5.02, the landing knee);
-//! measured on main 40536a7, 8 steps, 100 frames/s (`tests/klaw_continuity.rs`). The landing
+//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.45 steady
+//! (the ankle at the second heel strike), 5.29 from standing with a stop, and on a 0.1 km/h ×
+//! 5 cm grid 6.7–7.0 km/h × 1.5–1.6 m (5.04–5.29 on main 40536a7) and 3.3 km/h × 1.55 m (5.02,
+//! the landing knee); 8 steps, 100 frames/s (`tests/klaw_continuity.rs`; 5.45 since the stance
+//! simulation locks at the paper's `l1` and the drawing lowers the pelvis instead,
+//! `draw::PelvisDrop`, docs/klaw.md). The landing
 //! knee, locked straight in swing3 as in the paper, starts flexing at 2–3 × its mean rate at
 //! heel strike. 7 km/h × 1.5 m is *above the walk–run transition*: its Froude number
 //! `v²/(g·l1)` is 0.53 > [`high_level::WALK_RUN_FROUDE`] (eq. 1 gives it a step of 1.16 × the

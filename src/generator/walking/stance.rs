@@ -145,35 +145,7 @@ pub struct StanceSpec {
     /// How much shorter than `l1` the rigid leg locks, as a fraction of `l1` (0: the paper's
     /// lock at `l1`; see [`lock_shortening`]).
     pub lock_short: f64,
-    /// How much shorter still the rigid (sagittal) leg locks so that the drawn 3-D leg reaches
-    /// its flat foot with the virtual leg's soft knee, m (0: none; see
-    /// [`StanceSpec::lock_length`]).
-    pub lock_reach: f64,
-    /// How much longer the drawn 3-D leg's hip–flat-ankle distance is at the lock than the
-    /// sagittal rigid leg, plus the virtual leg's soft knee (`2σ` and a margin), m: what the lock
-    /// must be shortened by ([`StanceSpec::lock_reach`]), or the drawn span lengthened by
-    /// ([`StanceSpec::drawn_span`]), for the flat foot to stay within reach (0: none).
-    pub flat_reach: f64,
-    /// How much shorter than `l1` the leg spring's rest length is through the stance's first
-    /// half, m (0: the paper's rest length `l1`; see [`StanceSpec::rest_length`]).
-    pub rest_reach: f64,
-    /// Fraction of the stance over which the shortened rest length ramps in from heel strike
-    /// ([`StanceSpec::rest_length`]; [`REST_RAMP_IN`], less in the slowest walks:
-    /// `generate::SLOW_REST_REACH`).
-    pub rest_ramp_in: f64,
 }
-
-/// Fraction of the stance over which the leg spring's shortened rest length ramps in from heel
-/// strike ([`StanceSpec::rest_length`]) from Froude speed 0.20 up (≈ 2 km/h at 1.8 m).
-pub const REST_RAMP_IN: f64 = 0.2;
-
-/// [`REST_RAMP_IN`] of the slowest walks (`generate::SLOW_REST_REACH`, blended over the same Froude
-/// speeds).
-pub const REST_RAMP_IN_SLOW: f64 = 0.1;
-
-/// Fraction of the stance from which the leg spring's rest length ramps back out to `l1` by the end
-/// of the stance ([`StanceSpec::rest_length`]).
-pub const REST_RAMP_OUT: f64 = 0.5;
 
 /// Froude speed `v/√(g·l1)` up to which the extension keeps the quadratic profile (3 km/h for
 /// a 1.8 m body, `l1` ≈ 0.87 m).
@@ -264,21 +236,12 @@ pub struct StanceRun {
 }
 
 impl StanceSpec {
-    /// The length the rigid leg locks at, m: `l1 (1 − lock_short) − lock_reach`.
-    ///
-    /// A change to the paper's model (issue 6): the stance model is sagittal, the drawn leg is
-    /// not — its hip sits `dz` ≈ 4–6 cm beside the foot (pelvis width, stride width, lateral
-    /// displacement) — so a sagittal leg locked at the straight leg's length put the 3-D
-    /// hip–ankle distance ≈ `dz²/2l` ≈ 2 mm beyond it, and with the virtual leg's soft knee
-    /// (flat only up to `l − 2σ`) the flat foot rolled onto its ball: the heel hovered ≈ 5 mm
-    /// up from foot flat to heel off. The rigid leg here is the sagittal projection of the 3-D
-    /// leg with that soft knee (`lock_reach`, set by the generator from the stance's largest
-    /// `dz`, at Froude speeds below 0.65: `generate::PROJECTED_LOCK_FROUDE_MAX`; below 0.24 with
-    /// the spring's rest length shortened too, [`StanceSpec::rest_length`]), so the stance
-    /// heel stays down until the extension lifts it. Above that speed the drawn knee takes the
-    /// same reach instead ([`StanceSpec::drawn_span`]).
+    /// The length the rigid leg locks at, m: `l1 (1 − lock_short)` — the paper's lock at the
+    /// unloaded leg length `l1` (§4.2), shorter by the midstance knee at speed
+    /// ([`lock_shortening`]). Nothing of the drawn 3-D leg enters: its lateral reach is the
+    /// drawing's (`draw::PelvisDrop`).
     pub fn lock_length(&self) -> f64 {
-        self.l1 * (1.0 - self.lock_short.max(0.0)) - self.lock_reach.max(0.0)
+        self.l1 * (1.0 - self.lock_short.max(0.0))
     }
 
     /// The longest hip–ankle span the virtual leg's flat and heel-off rules may draw for this
@@ -288,21 +251,13 @@ impl StanceSpec {
     /// length is drawn as the heel rising (the paper's heel-off rule, one knee angle earlier);
     /// longer by as much as the leg locked above that length where it turned, up to `leg_span`
     /// (the paper's straight knee: the first step at a new, faster speed, whose hip comes in
-    /// high); `leg_span` when it never locked or `lock_short` is 0. `lock_reach` does not
-    /// shorten it: it is the drawn leg's lateral geometry, not a knee flexion to keep. The part
-    /// of [`StanceSpec::flat_reach`] the lock does not take (`flat_reach − lock_reach`)
-    /// lengthens it, up to `leg_span`: the midstance knee is drawn with the 3-D leg's flexion.
+    /// high); `leg_span` when it never locked or `lock_short` is 0.
     pub fn drawn_span(&self, run: &StanceRun, leg_span: f64) -> f64 {
-        // Only the midstance knee's shortening: `lock_reach` is the drawn leg's own geometry.
-        // A leg that locked where it turned above the lock length keeps the knee it turned
-        // with (the span grows by as much, up to the straight leg).
         let short = self.l1 * self.lock_short.max(0.0);
-        // The flat foot's reach the lock left to the drawn knee.
-        let reach = (self.flat_reach - self.lock_reach.max(0.0)).max(0.0);
         match run.lock_time {
             Some(t) if short > 0.0 => {
                 let above = (run.track.at(t).0[0] - self.lock_length()).max(0.0);
-                (leg_span - short + above + reach).min(leg_span)
+                (leg_span - short + above).min(leg_span)
             }
             _ => leg_span,
         }
@@ -313,16 +268,6 @@ impl StanceSpec {
     /// RK4 stage of the segment ending at `torque_off` is evaluated at `t + h`, which rounds to
     /// either side of the switch, and a torque read from `t` there made `θ̇1` jump by `h·A/(6I)`
     /// (a discontinuous shooting residual that stalled the solver, issue 6 / klawfix).
-    /// The leg spring's rest length at stance time `t`, m: `l1` shortened by
-    /// [`StanceSpec::rest_reach`] (smoothstep in over the first [`REST_RAMP_IN`] of the
-    /// stance, out again from [`REST_RAMP_OUT`] to its end).
-    pub fn rest_length(&self, t: f64) -> f64 {
-        let d = self.duration.max(1e-9);
-        let on = smoothstep((t / (self.rest_ramp_in.max(1e-3) * d)).clamp(0.0, 1.0));
-        let off = smoothstep(((t / d - REST_RAMP_OUT) / (1.0 - REST_RAMP_OUT)).clamp(0.0, 1.0));
-        self.l1 - self.rest_reach.max(0.0) * on * (1.0 - off)
-    }
-
     fn forces(&self, t: f64, y: &[f64; 7], f1: f64, sub: Sub, ext: (f64, f64, f64)) -> [f64; 3] {
         let f2 = -self.k2 * (y[2] - self.theta2_ref) - self.c2 * y[5];
         let pa = match sub {
@@ -333,7 +278,7 @@ impl StanceSpec {
             }
             _ => y[6],
         };
-        let fw = self.k_w * (self.rest_length(t) + pa - y[0]) - self.v_w * y[3];
+        let fw = self.k_w * (self.l1 + pa - y[0]) - self.v_w * y[3];
         [fw, f1, f2]
     }
 
@@ -449,8 +394,7 @@ impl StanceSpec {
                         let q = [y[0], y[1], y[2]];
                         let qd = [y[3], y[4], y[5]];
                         let f = self.forces(t, &y, f1, sub, ext);
-                        self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0]
-                            - self.rest_length(t)
+                        self.model.locked_reaction(&q, &qd, &f) / self.k_w + y[0] - self.l1
                     } else {
                         y[6]
                     };
@@ -609,10 +553,6 @@ mod tests {
             max_step: 0.004,
             push_off: 2.0,
             lock_short: 0.0,
-            lock_reach: 0.0,
-            flat_reach: 0.0,
-            rest_reach: 0.0,
-            rest_ramp_in: REST_RAMP_IN,
         };
         let start = StanceStart {
             q: [
@@ -792,49 +732,6 @@ mod tests {
     }
 
     #[test]
-    fn a_shortened_rest_length_ramps_in_and_out_and_lowers_the_hip() {
-        let (spec, start) = grazing_spec();
-        let d = spec.duration;
-        let short = StanceSpec {
-            rest_reach: 0.01,
-            ..spec
-        };
-        // The paper's rest length without a reach; l1 − reach from REST_RAMP_IN to
-        // REST_RAMP_OUT of the stance, l1 at both ends, monotone in between.
-        for i in 0..=100 {
-            let t = d * i as f64 / 100.0;
-            assert_eq!(spec.rest_length(t), spec.l1);
-            let f = i as f64 / 100.0;
-            let r = short.rest_length(t);
-            if (REST_RAMP_IN..=REST_RAMP_OUT).contains(&f) {
-                assert!((r - (spec.l1 - 0.01)).abs() < 1e-12, "{f}: {r}");
-            }
-            if i > 0 {
-                let before = short.rest_length(d * (i - 1) as f64 / 100.0);
-                let falling = f <= REST_RAMP_OUT;
-                assert!(if falling { r <= before } else { r >= before }, "{f}");
-            }
-        }
-        assert_eq!(short.rest_length(0.0), spec.l1);
-        assert!((short.rest_length(d) - spec.l1).abs() < 1e-12);
-        // The spring rests shorter, so the leg is compressed further before it locks (2.3 mm at
-        // 15 % of this stance).
-        let h = spec.step(&start);
-        let r0 = spec.run(&start, 60.0, 0.0, h, true);
-        let r1 = short.run(&start, 60.0, 0.0, h, true);
-        let w = |r: &StanceRun, f: f64| r.track.at(f * d).0[0];
-        assert!(
-            w(&r1, 0.15) < w(&r0, 0.15) - 1.5e-3,
-            "{} vs {}",
-            w(&r1, 0.15),
-            w(&r0, 0.15)
-        );
-        // This leg regains its lock from below either way: it locks later, at the same length.
-        assert!(r1.lock_time.unwrap_or(0.0) > r0.lock_time.unwrap_or(f64::INFINITY));
-        assert!((w(&r1, 0.5) - w(&r0, 0.5)).abs() < 1e-3);
-    }
-
-    #[test]
     fn a_leg_locked_short_keeps_its_length_and_the_drawn_knee_its_flexion() {
         assert_eq!(lock_shortening(2.0), 0.0);
         assert!((lock_shortening(3.0) - LOCK_SHORT_PER_PUSH).abs() < 1e-15);
@@ -875,12 +772,6 @@ mod tests {
                 let above = (w - soft.lock_length()).max(0.0);
                 assert!((span - (leg_span - 0.005 * spec.l1 + above)).abs() < 1e-12);
                 assert!(span <= leg_span - 0.005 * spec.l1 + 1e-3);
-                // The lateral reach shortens the lock, not the drawn span.
-                let reach = StanceSpec {
-                    lock_reach: 0.004,
-                    ..soft
-                };
-                assert!((reach.lock_length() - (soft.lock_length() - 0.004)).abs() < 1e-15);
             }
         }
         assert!(from_below > 0, "no lock regained from below");
@@ -900,31 +791,6 @@ mod tests {
         assert!(span > leg_span - 0.02 * spec.l1 + 5e-4);
         // Without the shortening, never shortened.
         assert_eq!(spec.drawn_span(&run, leg_span), leg_span);
-        // The flat foot's reach the lock does not take lengthens the drawn span (the 3-D leg's
-        // knee), never beyond the straight leg; the part the lock takes does not.
-        let reach = StanceSpec {
-            flat_reach: 0.005,
-            ..short
-        };
-        let longer = reach.drawn_span(&run, leg_span);
-        assert!(
-            (longer - (span + 0.005).min(leg_span)).abs() < 1e-12 && longer > span + 1e-3,
-            "{longer} vs {span} (leg {leg_span})"
-        );
-        let taken = StanceSpec {
-            lock_reach: 0.003,
-            ..reach
-        };
-        let run = taken.run(&start, 76.0, 0.0, taken.step(&start), true);
-        let w = run.track.at(run.lock_time.expect("locked")).0[0];
-        let above = (w - taken.lock_length()).max(0.0);
-        let expected = (leg_span - 0.02 * spec.l1 + above + 0.002).min(leg_span);
-        assert!((taken.drawn_span(&run, leg_span) - expected).abs() < 1e-12);
-        let wide = StanceSpec {
-            flat_reach: 0.05,
-            ..short
-        };
-        assert_eq!(wide.drawn_span(&run, leg_span), leg_span);
     }
 
     #[test]

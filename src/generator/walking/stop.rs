@@ -21,6 +21,7 @@ use super::foot::FootShape;
 use super::track::interp_rho;
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
 use crate::events::Side;
+use crate::generator::curves::smootherstep;
 
 /// Knee slack of the standing legs.
 pub const STAND_KNEE_SLACK: f64 = 0.001;
@@ -424,12 +425,6 @@ impl Closing {
             trail_contact,
         }
     }
-}
-
-/// 6s⁵ − 15s⁴ + 10s³.
-fn smootherstep(s: f64) -> f64 {
-    let s = s.clamp(0.0, 1.0);
-    s * s * s * (s * (6.0 * s - 15.0) + 10.0)
 }
 
 #[cfg(test)]
