@@ -14,7 +14,9 @@ use std::path::Path;
 use super::drive::Driven;
 use super::{measure_generated, Subject};
 use crate::events::{Gait, Side};
-use crate::generator::generalize::compare::{measured_stride, schreiber_leg};
+use crate::generator::generalize::compare::{
+    compare, mean_scores, measured_stride, schreiber_leg, MeanScores, MeasuredStride, Target,
+};
 use crate::generator::generalize::figure::{metadata, walk_motion, StepPlan};
 use crate::generator::generalize::{Generalizer, DEFAULT_ALPHA};
 use crate::generator::skeleton::Skeleton;
@@ -100,6 +102,69 @@ pub fn drive_kb(
         src.trial,
         why.join("; ")
     ))
+}
+
+/// Leave-one-out across the walking subjects of one calibration (issue 21 item 5): every
+/// measured stride (Schreiber marker set) generalized from every other subject's stride of the
+/// same leg and condition, by the paper's variant and the carried one, against naive scaling.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KbLeaveOneOut {
+    /// Subjects with at least one stride.
+    pub subjects: usize,
+    /// Strides (targets).
+    pub strides: usize,
+    /// Mean scores over the targets ([`compare`]'s protocol).
+    pub mean: MeanScores,
+    /// Source–target pairs that could not be generalized (a μ out of its range).
+    pub left_out: usize,
+}
+
+/// The leave-one-out comparison over `subjects` (walking subjects whose trials carry the
+/// Schreiber marker set); `None` with fewer than two such subjects.
+pub fn leave_one_out(subjects: &[&Subject]) -> Option<KbLeaveOneOut> {
+    let mut strides: Vec<MeasuredStride> = Vec::new();
+    let mut with = 0;
+    for s in subjects.iter().filter(|s| s.gait == Gait::Walk) {
+        let before = strides.len();
+        for c in &s.conditions {
+            let Ok(trial) = read_trial(Path::new(&c.path), &ReadOptions::default()) else {
+                continue;
+            };
+            for side in [Side::Left, Side::Right] {
+                if let Ok(m) = schreiber_leg(&trial, side).and_then(|(leg, ev)| {
+                    measured_stride(&leg, &ev, DEFAULT_ALPHA, &s.name, &c.trial, side)
+                }) {
+                    strides.push(m);
+                }
+            }
+        }
+        with += usize::from(strides.len() > before);
+    }
+    if with < 2 {
+        return None;
+    }
+    // Conditions are compared by name across subjects (Schreiber's C1…C5 in the file names).
+    for m in &mut strides {
+        if let Some(c) = m
+            .condition
+            .split('_')
+            .find(|p| p.starts_with('C') && p.len() == 2)
+        {
+            m.condition = c.to_string();
+        }
+    }
+    let rows = compare(&strides, DEFAULT_ALPHA, Target::Measured);
+    let left_out = rows
+        .iter()
+        .flat_map(|r| &r.failures)
+        .filter(|f| f.starts_with("from "))
+        .count();
+    Some(KbLeaveOneOut {
+        subjects: with,
+        strides: strides.len(),
+        mean: mean_scores(&rows),
+        left_out,
+    })
 }
 
 /// The Ko–Badler stage of a walking subject with two or more conditions: per condition, the

@@ -385,6 +385,8 @@ pub struct Calibration {
     pub failed: Vec<String>,
     /// The generated motions' settings.
     pub drive: DriveOptions,
+    /// Ko–Badler leave-one-out across the walking subjects (paper, carried, naive scaling).
+    pub kb_leave_one_out: Option<kb::KbLeaveOneOut>,
 }
 
 /// Calibrates every subject (`progress` is called with each subject's one-line summary).
@@ -403,12 +405,14 @@ pub fn calibrate(
         progress(i + 1, n, &r);
         out.push(r);
     }
+    let kb_leave_one_out = kb::leave_one_out(&out.iter().map(|r| &r.subject).collect::<Vec<_>>());
     Ok(Calibration {
         subjects: out,
         relations_source: rel.source.clone(),
         relation_notes,
         failed,
         drive: opts.drive,
+        kb_leave_one_out,
     })
 }
 

@@ -320,6 +320,9 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
     for n in &cal.relation_notes {
         let _ = write!(h, "<p class=\"note\">{}</p>", esc(n));
     }
+    if let Some(l) = &cal.kb_leave_one_out {
+        h.push_str(&kb_loo_html(l));
+    }
     for f in &cal.failed {
         let _ = write!(h, "<p class=\"note\">not measured: {}</p>", esc(f));
     }
@@ -481,6 +484,40 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
     }
     h.push_str("<p class=\"note\">Data: cite the sources of the inputs (see ../shared/data/README.md).</p></body></html>\n");
     crate::fsio::write_atomic_bytes(path, h.as_bytes()).map_err(|e| werr(path, e))
+}
+
+/// The Ko–Badler leave-one-out table (paper variant, carried variant, naive scaling).
+fn kb_loo_html(l: &super::kb::KbLeaveOneOut) -> String {
+    let row = |name: &str, s: &crate::generator::generalize::compare::Scores| {
+        format!(
+            "<tr><td>{name}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td><td>{:.1}</td></tr>",
+            s.hip_deg, s.knee_deg, s.ankle_deg, s.ankle_path_cm
+        )
+    };
+    let m = &l.mean;
+    format!(
+        "<section><h2>Ko–Badler across subjects (leave-one-out)</h2><p>Each of {} strides of {} \
+         walking subjects generalized (ψ then φ) from every other subject's stride of the same leg \
+         and condition, scored against the measured stride: RMS over the normalized stride, mean \
+         per target then over targets ({} pair(s) left out: a μ out of its range). <i>Paper</i>: \
+         the angles of W's rigid two-link drawing. <i>Carried</i>: the source's measured-minus-\
+         rendered angle residual carried onto the generalized step — the subject's character the \
+         rigid drawing cannot show; the positions, and so the ankle path and the motion files, are \
+         the paper's. <i>Naive scaling</i>: the source's measured stride unchanged on normalized \
+         time, its ankle path scaled by the leg-length ratio.</p><table><tr><th>candidate</th>\
+         <th>hip (deg)</th><th>knee (deg)</th><th>ankle (deg)</th><th>swing ankle path (cm)</th>\
+         </tr>{}{}{}{}</table><p class=\"note\">The carried variant is closer than the paper's but \
+         not as close as naive scaling: φ changes the drawn angles more than a subject's own \
+         change of speed does (eq. 27 pins the hip heights and lowers the mid-stance hip of \
+         longer steps).</p></section>",
+        l.strides,
+        l.subjects,
+        l.left_out,
+        row("paper", &m.generalized_same),
+        row("carried", &m.carried_same),
+        row("naive scaling", &m.naive_same),
+        row("model floor (own step drawn)", &m.floor),
+    )
 }
 
 /// Writes `residuals.csv`, `calibrated.json` and `report.html` into `dir`.

@@ -83,6 +83,20 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     for f in &cal.failed {
         eprintln!("gaitfit: warning: not measured: {f}");
     }
+    if let Some(l) = &cal.kb_leave_one_out {
+        let (p, c, n) = (
+            l.mean.generalized_same,
+            l.mean.carried_same,
+            l.mean.naive_same,
+        );
+        println!(
+            "Ko–Badler leave-one-out ({} strides, {} subjects), hip/knee/ankle RMS deg, ankle path cm: \
+             paper {:.1}/{:.1}/{:.1}, {:.1}; carried {:.1}/{:.1}/{:.1}, {:.1}; naive scaling {:.1}/{:.1}/{:.1}, {:.1}",
+            l.strides, l.subjects, p.hip_deg, p.knee_deg, p.ankle_deg, p.ankle_path_cm,
+            c.hip_deg, c.knee_deg, c.ankle_deg, c.ankle_path_cm,
+            n.hip_deg, n.knee_deg, n.ankle_deg, n.ankle_path_cm
+        );
+    }
     output::write_all(&args.out, &cal)?;
     println!(
         "gaitfit calibrate: {} subject(s) → {}/report.html, residuals.csv, calibrated.json",
