@@ -162,6 +162,41 @@ fn flight_time_knot_set_and_conditional_cr1() {
     }
 }
 
+/// run-tflight-sf's k1 set with CR2 (the default below 20 subjects): the design effect from
+/// the CR2 covariance (dense, `common.cr2`), the accepted partitions and the pieces, against the
+/// script's exhaustive partitions; the hull covers 152–173 as the issue asks.
+#[test]
+fn flight_time_knot_set_with_cr2() {
+    let tables = bundled();
+    let want = &reference()["run-tflight-sf"];
+    let r = fit(&tables, "run-tflight-sf", SeMethod::Cr2);
+    let bp = r
+        .breakpoints
+        .iter()
+        .find(|b| b.name == "k1")
+        .expect("k1 set");
+    close(
+        bp.design_effect.expect("design effect"),
+        num(&want["k1_design_effect_cr2"]),
+        1e-9,
+        "k1 CR2 design effect",
+    );
+    assert_eq!(bp.accepted as f64, num(&want["k1_accepted_cr2"]));
+    let pieces = want["k1_pieces_cr2"].as_array().expect("pieces");
+    assert_eq!(bp.pieces.len(), pieces.len(), "{:?}", bp.pieces);
+    for (g, w) in bp.pieces.iter().zip(pieces) {
+        for e in 0..2 {
+            match (g[e], w[e].as_f64()) {
+                (Some(a), Some(b)) => close(a, b, 1e-12, "k1 CR2 piece end"),
+                (None, None) => {}
+                (a, b) => panic!("k1 CR2 piece end {a:?} vs {b:?}"),
+            }
+        }
+    }
+    let k1 = coef(&r, "k1");
+    assert!(k1.ci95[0].is_none_or(|v| v <= 152.0) && k1.ci95[1].is_none_or(|v| v >= 173.0));
+}
+
 /// run-sl-v: v_norm from the profile, a and the mean slope b with per-subject slopes absorbed,
 /// their CR1 standard errors conditional on v_norm and with v_norm free, the levels' iid ones.
 #[test]

@@ -124,6 +124,11 @@ def tflight(df):
     delta = float(np.trace(np.linalg.solve(v_iid, cl.cov_params())) / 7)
     n_iid, pieces_iid = pieces_of(r.min() + sigma2 * scipy.stats.f.ppf(0.95, 1, dfr))
     n_acc, pieces = pieces_of(r.min() + sigma2 * delta * scipy.stats.f.ppf(0.95, 1, G - 1))
+    # The same with CR2 (the default below 20 subjects): the design effect from the dense CR2
+    # covariance of the linear coefficients, against the same F(1, G − 1).
+    v2, _, _ = cr2(xd, y - xd @ cl.params, g)
+    delta2 = float(np.trace(np.linalg.solve(v_iid, v2)) / 7)
+    n_acc2, pieces2 = pieces_of(r.min() + sigma2 * delta2 * scipy.stats.f.ppf(0.95, 1, G - 1))
     return {
         "n": int(n),
         "clusters": int(g.max() + 1),
@@ -133,6 +138,9 @@ def tflight(df):
         "k1_pieces": pieces,
         "k1_design_effect": delta,
         "k1_accepted_iid": n_iid,
+        "k1_design_effect_cr2": delta2,
+        "k1_accepted_cr2": n_acc2,
+        "k1_pieces_cr2": pieces2,
         "k1_pieces_iid": pieces_iid,
         "coef": list(raw),
         "se_cr1_conditional": list(np.sqrt(np.diag(vraw))),
