@@ -58,10 +58,12 @@ events build them) is in the `data/*.csv` tables.
     Schreiber trials, n 24 each): heel strike −8.1 ± 6.2 ms, toe off +18.2 ± 8.9 ms
     (printed on stderr by `gaitfit events` whenever a file has both). `--events
     force-then-reference` builds the steps from the plates' events where the plates saw the
-    event and the file's events elsewhere (tests/events_reference_plates.rs). It is not yet
-    the `auto` choice: switching changes `data/walk_schreiber2019.csv`, hence `fits/`, the
-    statsmodels references and the KLAW default μ coefficients, owned elsewhere.
-  - *WBDS04 double support, both readings*: section "WBDS04 double support" below.
+    event and the file's events elsewhere (tests/events_reference_plates.rs); it is the
+    `auto` choice for files with both (third pass), so `data/walk_schreiber2019.csv`, `fits/`
+    and the statsmodels references were regenerated.
+  - *WBDS04 double support*: the default is now the plain 20 N reading (the guide's truth,
+    issue 19's figures within 4 ms); bridging the export's dropouts is `--bridge-dropouts`
+    (section "WBDS04 double support" below).
 
 - **Issue 19 (latest).** Running from markers alone: `foot_jerk` (`--events kinematic` on a
   run) against numpy's 20 N events on Hamner subject01, every event in the record: heel strike
@@ -167,28 +169,34 @@ run "BMClab Gait.c3d (a Vicon C3D walking sample; two plates, one contact each)"
 run "BMClab running trial (one contact per foot)" bmclab/motion_capture_run.trc+bmclab/grf_run.mot --compare force
 run "Hamner subject01 (the runner with markers), treadmill" hamner2013/subject01 --compare force
 run "Schreiber: kinematic methods vs the C3D's own events" schreiber2019 --compare reference
-printf '\n## WBDS04 double support: dropouts bridged or not\n\n'
+printf '\n## WBDS04 double support: the default and --bridge-dropouts\n\n'
 cat <<'EOF'
+Force-plate truth is 20 N on the unfiltered vertical force (the developers' guide), and that
+is gaitfit's default: a contact's edges are those of the unfiltered force's runs above 20 N
+lasting at least 50 ms (shorter runs are blips; a dip between two such runs is no swing).
 The WBDS export zeroes every channel of a belt together on some samples; in a contact's
-unloading tail the nonzero samples it leaves after the first zero are the foot's load (they
-fall monotonically — 267 of 270 pairs —, occur only within ~30 ms of the cut, never in mid
-swing: 1 sample above 20 N in 20 232; at the first zero the force drops ~100 N in one sample
-while the other belt's changes as usual). gaitfit bridges them by default (a contact ends after
-its last loaded sample); `--no-bridge` ends it at the first zero, as a plain threshold on the
-export does. Mean double support per trial, s (`tools/events/force_truth.py`, numpy, writes
-`tools/events/wbds04_double_support.csv`; `tests/events_force_timing.rs` checks both):
+unloading tail the nonzero samples it leaves after the first zero look like the foot's load
+(they fall monotonically — 267 of 270 pairs —, occur only within ~30 ms of the cut, never in
+mid swing: 1 sample above 20 N in 20 232; at the first zero the force drops ~100 N in one
+sample while the other belt's changes as usual). By default the zero ends the contact, as a
+plain threshold on the export does; `gaitfit events` says so on stderr once per batch (how
+many contacts, and what `--bridge-dropouts` would change), and `--bridge-dropouts` times the
+toe off after the tail. Mean double support per trial, s (`tools/events/force_truth.py`,
+numpy, writes `tools/events/wbds04_double_support.csv`; `tests/events_force_timing.rs` checks
+both readings, every event within 2 ms and each mean within 6 ms):
 
-| trial | gaitfit (bridged) | numpy, joined | gaitfit `--no-bridge` | numpy, naive | issue 19 |
+| trial | gaitfit (default) | numpy, plain 20 N | issue 19 | gaitfit `--bridge-dropouts` | numpy, bridged |
 |---|---|---|---|---|---|
-| T05 (1.30 m/s) | 0.0826 | 0.0827 | 0.0660 | 0.0662 | 0.070 |
-| T06 (1.49 m/s) | 0.0702 | 0.0703 | 0.0587 | 0.0590 | 0.060 |
-| T07 (1.69 m/s) | 0.0611 | 0.0611 | 0.0503 | 0.0498 | 0.050 |
-| T08 (1.88 m/s) | 0.0577 | 0.0575 | 0.0501 | 0.0500 | 0.047 |
+| T05 (1.30 m/s) | 0.0660 | 0.0662 | 0.070 | 0.0826 | 0.0827 |
+| T06 (1.49 m/s) | 0.0587 | 0.0590 | 0.060 | 0.0702 | 0.0703 |
+| T07 (1.69 m/s) | 0.0497 | 0.0498 | 0.050 | 0.0611 | 0.0611 |
+| T08 (1.88 m/s) | 0.0501 | 0.0500 | 0.047 | 0.0577 | 0.0575 |
 
-The issue's "truth" is the naive reading (gaitfit `--no-bridge` within 4 ms of it and within
-0.5 ms of numpy's naive); the bridged reading is the one the data support, and the default.
+The force events of the other data sets do not move with `--bridge-dropouts` (Hamner: numpy's
+plain and bridged events are identical, gaitfit within 0.014 ms of them; Schreiber's and
+BMClab's plate events identical in both readings, `--events force --events-out`).
 EOF
-run "WBDS subject 04, dropouts not bridged" wbds --summary --no-bridge
+run "WBDS subject 04, dropouts bridged (--bridge-dropouts)" wbds --summary --bridge-dropouts
 cat <<'EOF'
 
 ## gaitkit 1.5 side by side (issue 19)

@@ -1,16 +1,15 @@
 //! Force events against 20 N on the unfiltered force, computed without gaitfit by
-//! `tools/events/force_truth.py` (numpy; thresholds the raw force, joins dropouts, interpolates
-//! the crossings): every reference event is found within 2 ms, and WBDS subject 04's mean double
-//! support per trial is within 6 ms of the reference (issue 19).
+//! `tools/events/force_truth.py` (numpy; thresholds the raw force, runs under 50 ms are blips,
+//! interpolates the crossings): every reference event is found within 2 ms, and WBDS subject
+//! 04's mean double support per trial is within 6 ms of the reference and of issue 19's
+//! figures (0.070/0.060/0.050/0.047 s).
 //!
 //! Double support is one period per step: the other foot's toe off after this foot's heel
-//! strike, minus that heel strike (`src/events/steps.rs`). The reference bridges the WBDS
-//! export's zeroed samples in an unloading tail (the nonzero samples after them fall
-//! monotonically and never occur in mid swing: the foot is still loaded; see the script's
-//! "dropout evidence"). Ending a contact at its first zeroed sample instead gives the
-//! `naive_double_support_mean_s` column (0.066/0.059/0.050/0.050 s), the figures issue 19 quotes
-//! as 0.070/0.060/0.050/0.047 s; gaitfit is compared with the bridged reference, and, with
-//! `bridge_dropouts = false` (`--no-bridge`), with the naive reference and the issue's figures.
+//! strike, minus that heel strike (`src/events/steps.rs`). The WBDS export zeroes isolated
+//! samples, some in unloading tails; by default (the guide's truth) a zero ends the contact.
+//! `bridge_dropouts = true` (`--bridge-dropouts`) times the toe off after the tail's later
+//! nonzero samples; it is compared with the script's bridged reference
+//! (`wbds04_force_events_bridged.csv`, `bridged_double_support_mean_s`).
 use gaitfit::events::{analyse, steps_from_analysis, EventKind, EventOptions, GaitEvent, Side};
 use gaitfit::ingest::{read_trial, ReadOptions};
 use gaitfit::shared_data::require;
@@ -69,17 +68,27 @@ fn check_events(label: &str, found: &[GaitEvent], reference: &[(Side, EventKind,
     worst
 }
 
-#[test]
-#[ignore = "needs ../shared/data"]
-fn wbds04_events_and_double_support_match_20_n_on_the_unfiltered_force() {
+/// Issue 19's WBDS04 double support (T05…T08), s: a plain 20 N threshold on the exported force.
+const ISSUE_DS_S: [(&str, f64); 4] = [
+    ("WBDS04walkT05", 0.070),
+    ("WBDS04walkT06", 0.060),
+    ("WBDS04walkT07", 0.050),
+    ("WBDS04walkT08", 0.047),
+];
+
+/// Checks one WBDS04 reading (`bridge`) against the script's events file `events_csv` and its
+/// double-support column `ds_col`; returns the mean double support per trial.
+fn wbds04_reading(bridge: bool, events_csv: &str, ds_col: usize) -> Vec<(String, f64)> {
     let root = require("wbds");
-    let events = tool_csv("wbds04_force_events.csv");
+    let events = tool_csv(events_csv);
     let ds = tool_csv("wbds04_double_support.csv");
+    let mut out = Vec::new();
     for row in &ds {
         let trial = &row[0];
         let path = root.join(format!("{trial}grf.txt"));
         let t = read_trial(&path, &ReadOptions::default()).unwrap();
-        let opts = EventOptions::default();
+        let mut opts = EventOptions::default();
+        opts.force.bridge_dropouts = bridge;
         let an = analyse(&t, &opts).unwrap();
         let reference: Vec<(Side, EventKind, f64)> = events
             .iter()
@@ -100,67 +109,45 @@ fn wbds04_events_and_double_support_match_20_n_on_the_unfiltered_force() {
             .filter_map(|r| r.double_support_time_s)
             .collect();
         let mean = d.iter().sum::<f64>() / d.len() as f64;
-        let want: f64 = row[2].parse().unwrap();
+        let want: f64 = row[ds_col].parse().unwrap();
         println!(
-            "{trial}: worst event error {:.3} ms; double support {mean:.4} s ({} steps), \
-             reference {want:.4} s ({} periods), ending contacts at the first zeroed sample {} s",
+            "{trial} (bridge {bridge}): worst event error {:.3} ms; double support {mean:.4} s \
+             ({} steps), reference {want:.4} s",
             worst * 1e3,
             d.len(),
-            row[1],
-            row[5]
         );
         assert!(
             (mean - want).abs() <= DOUBLE_SUPPORT_TOL_S,
             "{trial}: double support {mean:.4} s, reference {want:.4} s"
         );
+        out.push((trial.clone(), mean));
     }
+    out
 }
-
-/// Issue 19's WBDS04 double support (T05…T08), s: a plain 20 N threshold on the exported force.
-const ISSUE_NAIVE_DS_S: [(&str, f64); 4] = [
-    ("WBDS04walkT05", 0.070),
-    ("WBDS04walkT06", 0.060),
-    ("WBDS04walkT07", 0.050),
-    ("WBDS04walkT08", 0.047),
-];
 
 #[test]
 #[ignore = "needs ../shared/data"]
-fn wbds04_without_bridging_reproduces_the_naive_reference_and_the_issue_figures() {
-    let root = require("wbds");
-    let ds = tool_csv("wbds04_double_support.csv");
-    for (trial, issue) in ISSUE_NAIVE_DS_S {
-        let row = ds.iter().find(|r| r[0] == trial).unwrap();
-        let path = root.join(format!("{trial}grf.txt"));
-        let t = read_trial(&path, &ReadOptions::default()).unwrap();
-        let mut opts = EventOptions::default();
-        opts.force.bridge_dropouts = false;
-        let an = analyse(&t, &opts).unwrap();
-        let steps = steps_from_analysis(&t, &an, &opts).unwrap();
-        let d: Vec<f64> = steps
-            .rows
-            .iter()
-            .filter_map(|r| r.double_support_time_s)
-            .collect();
-        let mean = d.iter().sum::<f64>() / d.len() as f64;
-        let naive: f64 = row[5].parse().unwrap();
-        let bridged: f64 = row[2].parse().unwrap();
-        println!(
-            "{trial}: not bridged {mean:.4} s ({} steps); numpy naive {naive:.4} s, issue \
-             {issue:.3} s; bridged reference {bridged:.4} s",
-            d.len()
-        );
-        assert!(
-            (mean - naive).abs() <= 0.002,
-            "{trial}: not bridged {mean:.4} s, numpy naive {naive:.4} s"
-        );
+fn wbds04_events_and_double_support_match_20_n_on_the_unfiltered_force() {
+    let plain = wbds04_reading(false, "wbds04_force_events.csv", 2);
+    for (trial, issue) in ISSUE_DS_S {
+        let (_, mean) = plain.iter().find(|(t, _)| t == trial).unwrap();
+        println!("{trial}: default {mean:.4} s, issue {issue:.3} s");
         assert!(
             (mean - issue).abs() <= DOUBLE_SUPPORT_TOL_S,
-            "{trial}: not bridged {mean:.4} s, issue {issue:.3} s"
+            "{trial}: default {mean:.4} s, issue {issue:.3} s"
         );
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn wbds04_bridged_dropouts_match_the_bridged_reference() {
+    let plain = wbds04_reading(false, "wbds04_force_events.csv", 2);
+    let bridged = wbds04_reading(true, "wbds04_force_events_bridged.csv", 5);
+    for ((trial, p), (_, b)) in plain.iter().zip(&bridged) {
         assert!(
-            bridged - mean > 0.005,
-            "{trial}: bridging should lengthen it"
+            b - p > 0.005,
+            "{trial}: bridging should lengthen it ({p:.4} → {b:.4} s)"
         );
     }
 }

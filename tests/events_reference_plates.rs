@@ -1,5 +1,5 @@
-//! Reference events and plates (issue 19 item 5): `--events force-then-reference` builds the
-//! steps from the plates' events where the plates saw the event (20 N on the unfiltered
+//! Reference events and plates (issue 19 item 5): where both exist, the steps are built (by
+//! default, and with `--events force-then-reference`) from the plates' events where the plates saw the event (20 N on the unfiltered
 //! vertical force, the truth there; its timing is checked against numpy in
 //! tests/events_force_timing.rs) and from the file's own events elsewhere, and the two
 //! sources' disagreement is measured.
@@ -74,10 +74,9 @@ fn schreiber_steps_take_the_plates_where_they_saw_the_event() {
         .collect();
     files.sort();
     assert_eq!(files.len(), 12);
-    let opts = EventOptions {
-        primary: PrimarySource::ForceThenReference,
-        ..EventOptions::default()
-    };
+    // The default (auto) takes the plates where they saw the event, the files' events elsewhere.
+    let opts = EventOptions::default();
+    assert_eq!(opts.primary, PrimarySource::Auto);
     let (mut hs, mut to) = (Vec::new(), Vec::new());
     for f in &files {
         let t = read_trial(f, &ReadOptions::default()).unwrap();

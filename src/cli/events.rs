@@ -46,16 +46,16 @@ pub struct Args {
     #[arg(short, long)]
     pub verbose: bool,
     /// Which events build the steps: auto (force with per-foot plates, else the file's own
-    /// events, else the plates if they saw two steps, else the markers' method for the gait),
+    /// events with the plates' in their place where the plates saw them, else the plates if they saw two steps, else the markers' method for the gait),
     /// force, kinematic (markers alone, the method for the trial's gait told from the data:
     /// foot-speed for walks, foot-jerk for runs), foot-speed (walks: Zeni windows refined by
     /// the heel and toe speed over the ground, Bonci et al. 2022), foot-jerk (runs: heel or
     /// metatarsal impact jerk at touchdown, toe speed over the ground at toe off), zeni,
     /// zeni-velocity, foot-height, reference (the file's own events, e.g. a C3D's),
     /// force-then-reference (the plates' events where the plates saw the event — 20 N on the
-    /// unfiltered force, the truth there — and the file's events elsewhere; not yet the auto
-    /// choice for files with both, see reports/events.md). Where a file has its own events and
-    /// plates, their disagreement (file − plates, per kind) is printed on stderr.
+    /// unfiltered force, the truth there — and the file's events elsewhere; auto's choice for
+    /// files with both, see reports/events.md). Where a file has its own events and plates,
+    /// their disagreement (file − plates, per kind) is printed on stderr.
     #[arg(long, default_value = "auto", value_name = "SOURCE")]
     pub events: String,
     /// Marker-name preset: auto, gaitfit, opensim, cortex, schreiber, pig, winter.
@@ -89,11 +89,14 @@ pub struct Args {
     /// Subtract a linear baseline from drifting force plates instead of failing.
     #[arg(long)]
     pub correct_drift: bool,
-    /// Time each force contact on the first run of the unfiltered force above --off lasting
-    /// 50 ms, instead of bridging samples an export zeroed in the unloading tail (WBDS): what a
-    /// plain threshold on the exported force gives; for comparison only (reports/events.md).
+    /// Bridge export dropouts: time a toe off after the last unfiltered sample above --off
+    /// near the contact's end, so isolated samples an export zeroed in the unloading tail
+    /// (WBDS) do not end the contact (longer stance and double support). Default: each contact
+    /// is timed on the first run of the unfiltered force above --off lasting 50 ms, 20 N on
+    /// the unfiltered force, the guide's truth; a batch whose contacts end at such dropouts
+    /// says so on stderr, with what this option would change (reports/events.md).
     #[arg(long)]
-    pub no_bridge: bool,
+    pub bridge_dropouts: bool,
     /// Marker low-pass cutoff, Hz.
     #[arg(long, default_value_t = 6.0)]
     pub marker_cutoff: f64,
@@ -140,7 +143,7 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     opts.force.on_n = args.on;
     opts.force.off_n = args.off;
     opts.force.correct_drift = args.correct_drift;
-    opts.force.bridge_dropouts = !args.no_bridge;
+    opts.force.bridge_dropouts = args.bridge_dropouts;
     opts.kinematic.cutoff_hz = args.marker_cutoff;
     Ok((read, opts))
 }
@@ -153,6 +156,12 @@ struct TrialResult {
     label: String,
     /// File event − plate event, s, per event the plates also saw.
     reference_minus_force_s: Vec<(crate::events::EventKind, f64)>,
+    /// Contacts ending at an export dropout (see `events::force`): the toe-off shift bridging
+    /// would make, s, each.
+    dropout_shifts_s: Vec<f64>,
+    /// Double support of every step, s, as written and (when the trial has dropouts and they
+    /// were not bridged) with `--bridge-dropouts`.
+    double_support_s: (Vec<f64>, Vec<f64>),
 }
 
 fn process(
@@ -190,9 +199,25 @@ fn process(
         crate::events::plot::write_svg(&dir.join(format!("{name}.svg")), &an)?;
         crate::events::plot::write_png(&dir.join(format!("{name}.png")), &an)?;
     }
+    let double_support = |t: &StepTable| -> Vec<f64> {
+        t.rows
+            .iter()
+            .filter_map(|r| r.double_support_time_s)
+            .collect()
+    };
+    let dropout_shifts_s = an.force.dropout_shifts_s.clone();
+    let bridged = if !dropout_shifts_s.is_empty() && !opts.force.bridge_dropouts {
+        let mut o = opts.clone();
+        o.force.bridge_dropouts = true;
+        let b = analyse(&trial, &o)?;
+        double_support(&steps_from_analysis(&trial, &b, &o)?)
+    } else {
+        Vec::new()
+    };
     let mut notes = trial.notes.clone();
     notes.extend(an.events.notes.iter().cloned());
     notes.extend(table.notes.iter().cloned());
+    let double_support_s = (double_support(&table), bridged);
     Ok(TrialResult {
         table,
         events,
@@ -200,6 +225,8 @@ fn process(
         notes,
         label: input.label(),
         reference_minus_force_s: an.events.reference_minus_force_s.clone(),
+        double_support_s,
+        dropout_shifts_s,
     })
 }
 
@@ -306,6 +333,44 @@ fn print_reference_disagreement(results: &[TrialResult]) {
     );
 }
 
+/// Prints, on stderr, one warning for the batch when force contacts end at export dropouts
+/// and they were not bridged: how many, and what `--bridge-dropouts` would change.
+fn print_dropouts(results: &[TrialResult]) {
+    let shifts: Vec<f64> = results
+        .iter()
+        .flat_map(|r| r.dropout_shifts_s.iter().map(|d| d * 1e3))
+        .collect();
+    let with: Vec<&TrialResult> = results
+        .iter()
+        .filter(|r| !r.double_support_s.1.is_empty())
+        .collect();
+    if shifts.is_empty() || with.is_empty() {
+        return;
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let plain: Vec<f64> = with
+        .iter()
+        .flat_map(|r| r.double_support_s.0.iter().copied())
+        .collect();
+    let bridged: Vec<f64> = with
+        .iter()
+        .flat_map(|r| r.double_support_s.1.iter().copied())
+        .collect();
+    eprintln!(
+        "warning: {} force contact(s) in {} trial(s) end at a sample the export zeroed, the \
+         force back above --off within a --force-cutoff period after it (dropouts); they end \
+         there (20 N on the unfiltered force). --bridge-dropouts would time their toe offs \
+         after the tail: {} ms later each, mean double support {:.3} → {:.3} s ({:+.0} ms) \
+         (reports/events.md)",
+        shifts.len(),
+        with.len(),
+        mean_sd_signed(&shifts),
+        mean(&plain),
+        mean(&bridged),
+        (mean(&bridged) - mean(&plain)) * 1e3
+    );
+}
+
 /// `+m.m ± s.s` of `v` (`–` when empty).
 fn mean_sd_signed(v: &[f64]) -> String {
     mean_and_sd(v).map_or_else(|| "–".into(), |(m, sd)| format!("{m:+.1} ± {sd:.1}"))
@@ -402,6 +467,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         }
     }
     print_reference_disagreement(&ok);
+    print_dropouts(&ok);
     if compare_with.is_some() {
         let mut all = CompareTable::default();
         for r in &ok {

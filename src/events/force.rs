@@ -17,10 +17,19 @@
 //!    within one period of the detection cutoff (1/`cutoff_hz`, the farthest the filter moves
 //!    an edge) of the filtered contact's edge: heel strike at the first sample of the contact
 //!    at or above the level (extended backward while the force stays at or above it), toe off
-//!    after its last, so isolated dropout samples inside a contact (the WBDS export zeroes
-//!    some) do not cut it short (`bridge_dropouts = false` takes the first run of the
-//!    unfiltered force at or above the level lasting `min_contact_s` instead, for comparison
-//!    with figures computed that way).
+//!    after its last. By default (20 N on the unfiltered vertical force, the guide's truth)
+//!    the edges are those of the unfiltered force's runs at or above the level lasting at
+//!    least `min_contact_s` (shorter runs are blips, as in the contact finding; a dip between
+//!    two such runs is no swing): heel strike where the first rises through the level, toe off
+//!    where the last falls through it, so a sample at zero in an unloading tail ends the
+//!    contact.
+//! 3. **Export dropouts** (opt-in bridging): the WBDS export zeroes isolated samples, some in
+//!    the unloading tail, where the nonzero samples that follow still fall monotonically (the
+//!    foot is still loaded; `tools/events/force_truth.py` prints the evidence). A contact that
+//!    ends at an exactly-zero raw sample with the force back at or above the level within one
+//!    detection period after it is counted as ending at a dropout
+//!    ([`ForceResult::dropout_shifts_s`]: how much later bridging would time its toe off);
+//!    `bridge_dropouts = true` (`--bridge-dropouts`) times such toe offs after the tail.
 //!
 //! Plates that carry one known foot (dual-belt treadmill belts, OpenSim `R_`/`L_` forces) give
 //! that foot's events directly. Overground plates (`side: None`) are assigned to a foot by the
@@ -59,18 +68,16 @@ pub struct ForceOptions {
     pub drift_tolerance_n: f64,
     /// Subtract a linear baseline fitted to the unloaded periods instead of failing on drift.
     pub correct_drift: bool,
-    /// Bridge dropouts at toe off (default `true`): a contact's toe off is timed after the
-    /// last unfiltered sample at or above `off_n` near the filtered contact's end, so samples
-    /// an export zeroed in the unloading tail (WBDS) do not end it. `false` times the contact
-    /// on the first run of the unfiltered force at or above `off_n` lasting `min_contact_s`:
-    /// what a plain threshold on the exported force gives (issue 19's WBDS04 double support
-    /// figures).
-    #[serde(default = "default_bridge")]
+    /// Bridge export dropouts (default `false`). `false` times each contact on the runs of
+    /// the unfiltered force at or above `off_n` lasting `min_contact_s` (from the first one's
+    /// rise to the last one's fall): 20 N on the
+    /// unfiltered vertical force, the developers' guide's force-plate truth (issue 19's WBDS04
+    /// double support figures). `true` times a contact's toe off after the last unfiltered
+    /// sample at or above `off_n` near the filtered contact's end, so samples an export zeroed
+    /// in the unloading tail (WBDS) do not end it (longer stance and double support; see the
+    /// module docs and reports/events.md).
+    #[serde(default)]
     pub bridge_dropouts: bool,
-}
-
-fn default_bridge() -> bool {
-    true
 }
 
 impl Default for ForceOptions {
@@ -85,7 +92,7 @@ impl Default for ForceOptions {
             min_gap_s: 0.05,
             drift_tolerance_n: 10.0,
             correct_drift: false,
-            bridge_dropouts: true,
+            bridge_dropouts: false,
         }
     }
 }
@@ -159,6 +166,12 @@ pub struct ForceResult {
     pub vertical: Vec<VerticalForce>,
     /// What was found or assumed.
     pub notes: Vec<String>,
+    /// Per contact that ends at an export dropout (an exactly-zero raw sample, the force back
+    /// at or above `off_n` within one detection period after it): how much later its toe off
+    /// would be with [`ForceOptions::bridge_dropouts`], s. Its toe off as timed (bridged or
+    /// not) is in `events`.
+    #[serde(default)]
+    pub dropout_shifts_s: Vec<f64>,
 }
 
 /// The index of the vertical axis of the trial (its frame, else Y, the OpenSim and treadmill
@@ -333,7 +346,15 @@ fn crossing(t: &[f64], x: &[f64], i: usize, level: f64) -> f64 {
 
 /// Contacts of one plate: found on the filtered force `f` by threshold with hysteresis, timed
 /// on `g` (see the module docs).
-fn threshold_contacts(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions) -> Vec<RawContact> {
+/// Also returns the toe-off shifts of the contacts that end at an export dropout (see
+/// [`retime`]); `raw` is the plate's unfiltered force before the baseline removal.
+fn threshold_contacts(
+    t: &[f64],
+    f: &[f64],
+    g: &[f64],
+    raw: &[f64],
+    opts: &ForceOptions,
+) -> (Vec<RawContact>, Vec<f64>) {
     let n = f.len();
     let level = opts.off_n;
     let mut out: Vec<RawContact> = Vec::new();
@@ -370,19 +391,29 @@ fn threshold_contacts(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions) -> V
         merged.push(c);
     }
     merged.retain(|c| c.2.is_none() || c.3.is_none() || t[c.1] - t[c.0] >= opts.min_contact_s);
-    retime(t, f, g, opts, &mut merged);
-    merged
+    let dropouts = retime(t, f, g, raw, opts, &mut merged);
+    (merged, dropouts)
 }
 
 /// Times each edge of `contacts` on the timing signal `g`: within one period of the detection
 /// cutoff of the filtered edge (the farthest a zero-phase low-pass at that cutoff moves an
 /// edge) and never past the middle of the gap to the neighbouring contact. An edge whose
-/// timing signal never reaches the level there keeps its filtered time.
-fn retime(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions, contacts: &mut [RawContact]) {
+/// timing signal never reaches the level there keeps its filtered time. Returns, per contact
+/// that ends at an export dropout (see the module docs), how much later bridging times its toe
+/// off, s.
+fn retime(
+    t: &[f64],
+    f: &[f64],
+    g: &[f64],
+    raw: &[f64],
+    opts: &ForceOptions,
+    contacts: &mut [RawContact],
+) -> Vec<f64> {
     let n = f.len();
     let level = opts.off_n;
     let w = (opts.cutoff_hz.recip() / median_dt(t)).ceil() as usize;
     let m = contacts.len();
+    let mut dropouts = Vec::new();
     for k in 0..m {
         let (s, e) = (contacts[k].0, contacts[k].1);
         // First index this contact may claim, last index it may claim.
@@ -396,58 +427,75 @@ fn retime(t: &[f64], f: &[f64], g: &[f64], opts: &ForceOptions, contacts: &mut [
         } else {
             n - 1
         };
-        if !opts.bridge_dropouts {
-            // No bridging: the contact is the first run of the timing signal at or above the
-            // level, at least `min_contact_s` long, in the edges' search range (a plain
-            // threshold on the exported force, shorter runs dropped as blips).
-            let (lo, hi) = (floor.max(s.saturating_sub(w)), ceil.min(e + w));
-            let mut j = lo;
-            while j <= hi {
-                if g[j] < level {
-                    j += 1;
-                    continue;
-                }
-                let a = j;
-                while j < hi && g[j + 1] >= level {
-                    j += 1;
-                }
-                // A run the record cuts is a contact of unknown length.
-                if t[j] - t[a] >= opts.min_contact_s || a == 0 || j + 1 >= n {
-                    if contacts[k].2.is_some() && a > 0 {
-                        contacts[k].2 = Some(crossing(t, g, a - 1, level));
-                    }
-                    if contacts[k].3.is_some() && j + 1 < n {
-                        contacts[k].3 = Some(crossing(t, g, j, level));
-                    }
-                    break;
-                }
+        let (lo, hi) = (floor.max(s.saturating_sub(w)), ceil.min(e + w));
+        let plain = plain_runs(t, g, level, lo, hi, opts.min_contact_s);
+        let bridged_on = (lo..=e).find(|&j| g[j] >= level).map(|mut j| {
+            while j > floor && g[j - 1] >= level {
+                j -= 1;
+            }
+            j
+        });
+        let bridged_off = (s..=hi).rev().find(|&j| g[j] >= level).map(|mut j| {
+            while j < ceil && g[j + 1] >= level {
                 j += 1;
             }
-            continue;
-        }
-        if contacts[k].2.is_some() {
-            let lo = floor.max(s.saturating_sub(w));
-            if let Some(mut j) = (lo..=e).find(|&j| g[j] >= level) {
-                while j > floor && g[j - 1] >= level {
-                    j -= 1;
-                }
-                if j > 0 {
-                    contacts[k].2 = Some(crossing(t, g, j - 1, level));
-                }
+            j
+        });
+        // An export dropout: the plain run ends at an exactly-zero raw sample and the force is
+        // back at or above the level before the bridged end.
+        if let (Some((_, pe)), Some(be)) = (plain, bridged_off) {
+            if contacts[k].3.is_some() && be > pe && pe + 1 < n && raw[pe + 1] == 0.0 {
+                dropouts.push(crossing(t, g, be, level) - crossing(t, g, pe, level));
             }
         }
-        if contacts[k].3.is_some() {
-            let hi = ceil.min(e + w);
-            if let Some(mut j) = (s..=hi).rev().find(|&j| g[j] >= level) {
-                while j < ceil && g[j + 1] >= level {
-                    j += 1;
-                }
-                if j + 1 < n {
-                    contacts[k].3 = Some(crossing(t, g, j, level));
-                }
+        let (on, off) = if opts.bridge_dropouts {
+            (bridged_on, bridged_off)
+        } else {
+            match plain {
+                Some((a, b)) => (Some(a), Some(b)),
+                None => (None, None),
             }
+        };
+        if let Some(j) = on.filter(|&j| j > 0 && contacts[k].2.is_some()) {
+            contacts[k].2 = Some(crossing(t, g, j - 1, level));
+        }
+        if let Some(j) = off.filter(|&j| j + 1 < n && contacts[k].3.is_some()) {
+            contacts[k].3 = Some(crossing(t, g, j, level));
         }
     }
+    dropouts
+}
+
+/// The contact a plain threshold on the force sees within `lo..=hi`: the runs of `g` at or
+/// above `level` lasting at least `min_s` (shorter runs are blips; a run the record cuts is a
+/// contact of unknown length and is kept), taken together — a dip between two such runs is
+/// no swing. Returns the first index of the first of them and the last index of the last.
+fn plain_runs(
+    t: &[f64],
+    g: &[f64],
+    level: f64,
+    lo: usize,
+    hi: usize,
+    min_s: f64,
+) -> Option<(usize, usize)> {
+    let n = g.len();
+    let mut out: Option<(usize, usize)> = None;
+    let mut j = lo;
+    while j <= hi {
+        if g[j].is_nan() || g[j] < level {
+            j += 1;
+            continue;
+        }
+        let a = j;
+        while j < hi && g[j + 1] >= level {
+            j += 1;
+        }
+        if t[j] - t[a] >= min_s || a == 0 || j + 1 >= n {
+            out = Some(out.map_or((a, j), |(s, _)| (s, j)));
+        }
+        j += 1;
+    }
+    out
 }
 
 /// Median sample interval of `t`, s (1 when it cannot be told).
@@ -539,7 +587,9 @@ pub fn detect(
     let mut unassigned: Vec<Contact> = Vec::new();
     for plate in &trial.plates {
         let (f, g, mut report) = vertical_force(plate, axis, &path, opts, &mut res.notes)?;
-        let raw = threshold_contacts(&plate.time_s, &f, &g, opts);
+        let unfiltered: Vec<f64> = plate.force_n.iter().map(|v| v[axis]).collect();
+        let (raw, dropouts) = threshold_contacts(&plate.time_s, &f, &g, &unfiltered, opts);
+        res.dropout_shifts_s.extend(dropouts);
         report.contacts = raw.len();
         for (s, e, on, off) in raw {
             let peak = f[s..=e].iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -821,30 +871,49 @@ mod tests {
 
     #[test]
     fn a_sharp_edge_and_dropouts_in_the_tail_are_timed_as_the_force_crosses() {
-        // 300 Hz, like WBDS: the force jumps from 0 to 300 N between two samples, and the
-        // unloading tail has isolated zero samples (121, 0, 83, 0, 0, 0, 56, 0, 0, 29, 0 N).
+        // 300 Hz, like WBDS: the force jumps from 0 to 300 N between two samples, one sample
+        // is zeroed in mid stance, and the unloading tail has isolated zero samples (121, 0,
+        // 83, 0, 0, 0, 56, 0, 0, 29, 0 N).
         let rate = 300.0;
         let mut fy = vec![0.0; 300];
         for v in fy.iter_mut().take(200).skip(60) {
             *v = 600.0;
         }
         fy[60] = 300.0;
+        fy[130] = 0.0;
         let tail = [121.0, 0.0, 83.0, 0.0, 0.0, 0.0, 56.0, 0.0, 0.0, 29.0];
         fy[200..210].copy_from_slice(&tail);
         let mut p = plate(Some(Side::Left), &[], rate, 1.0);
         for (f, v) in p.force_n.iter_mut().zip(&fy) {
             f[1] = *v;
         }
-        let r = detect(&trial(vec![p]), None, &ForceOptions::default()).unwrap();
+        let t = trial(vec![p]);
+        let r = detect(&t, None, &ForceOptions::default()).unwrap();
+        // One contact: the mid-stance zero splits two runs of 70 samples, no swing.
+        assert_eq!(r.contacts.len(), 1);
         // Heel strike between samples 59 (0 N) and 60 (300 N): 59 + 20/300.
         let hs = times(&r, EventKind::HeelStrike);
         assert!(
             (hs[0] - (59.0 + 20.0 / 300.0) / rate).abs() < 1e-9,
             "{hs:?}"
         );
-        // Toe off after the last loaded sample (209, 29 N) and before 210 (0 N): 209 + 9/29.
+        // Default (20 N on the unfiltered force): the tail's first zero ends the contact,
+        // between samples 200 (121 N) and 201 (0 N): 200 + 101/121.
         let to = times(&r, EventKind::ToeOff);
-        assert!((to[0] - (209.0 + 9.0 / 29.0) / rate).abs() < 1e-9, "{to:?}");
+        let plain = (200.0 + 101.0 / 121.0) / rate;
+        assert!((to[0] - plain).abs() < 1e-9, "{to:?}");
+        // Bridged: after the last loaded sample (209, 29 N) and before 210 (0 N): 209 + 9/29.
+        let bridged = (209.0 + 9.0 / 29.0) / rate;
+        assert_eq!(r.dropout_shifts_s.len(), 1);
+        assert!((r.dropout_shifts_s[0] - (bridged - plain)).abs() < 1e-9);
+        let opts = ForceOptions {
+            bridge_dropouts: true,
+            ..ForceOptions::default()
+        };
+        let rb = detect(&t, None, &opts).unwrap();
+        let to = times(&rb, EventKind::ToeOff);
+        assert!((to[0] - bridged).abs() < 1e-9, "{to:?}");
+        assert_eq!(times(&rb, EventKind::HeelStrike), hs);
     }
 
     #[test]

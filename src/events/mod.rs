@@ -144,7 +144,8 @@ pub enum EventError {
 pub enum PrimarySource {
     /// Force-plate events when every contact of both feet falls on a plate (per-foot plates:
     /// dual-belt treadmill, OpenSim `R_`/`L_` forces); otherwise the file's measured reference
-    /// events (C3D EVENT group; not a generator's own events); otherwise the force events if
+    /// events (C3D EVENT group; not a generator's own events), with the plates' events in
+    /// their place where the plates saw them (`force-then-reference`); otherwise the force events if
     /// the plates saw at least two steps
     /// (successive heel strikes of opposite feet, no contact beside the plates in between:
     /// an overground walkway); otherwise, in walking, the foot-speed detector (Zeni windows
@@ -172,7 +173,8 @@ pub enum PrimarySource {
     /// The events stored in the file (C3D EVENT group).
     Reference,
     /// The force plates' events where the plates saw the event (20 N on the unfiltered force),
-    /// the file's events elsewhere (see [`force_then_reference`]).
+    /// the file's events elsewhere (see [`force_then_reference`]); the automatic choice for
+    /// files with both.
     ForceThenReference,
 }
 
@@ -561,6 +563,14 @@ fn choose_primary(
             // (Schreiber & Moissenet 2019) agree with the plates to a frame (reports/events.md).
             if ev.force_complete && has_both_kinds(&ev.force) {
                 Ok(EventSource::Force)
+            } else if has_both_kinds(&ev.reference)
+                && measured(&ev.reference)
+                && has_both_kinds(&ev.force_then_reference)
+            {
+                // Plates and the file's events both: the plates where they saw the event (the
+                // Schreiber files' toe offs are +18 ± 9 ms late against them), the file's
+                // events beside the plates (reports/events.md).
+                Ok(EventSource::ForceThenReference)
             } else if has_both_kinds(&ev.reference) && measured(&ev.reference) {
                 Ok(EventSource::Reference)
             } else if has_both_kinds(&ev.force)

@@ -3,12 +3,13 @@
 
 numpy only, and a different algorithm from gaitfit's (which finds contacts on the filtered
 force and then times them on the unfiltered one): per foot channel, the unloaded level is the
-median of the samples below 20 N; the force above it is thresholded at 20 N; loaded runs
-separated by less than 50 ms are joined (the WBDS export has isolated zero samples inside
-contacts, e.g. 121, 0, 83, 0, 0, 0, 56, 0, 0, 29 N while the foot unloads), runs shorter than
-50 ms (unless the record cuts them) or never reaching 50 N are dropped; heel strike is the linear interpolation of the 20 N crossing between the last
-unloaded and the first loaded sample of a run, toe off between the last loaded and the first
-unloaded sample. Runs that touch the record's ends have no event there.
+median of the samples below 20 N; the force above it is thresholded at 20 N; runs shorter than
+50 ms are blips (unless the record cuts them), the others less than 50 ms apart are one
+contact (no swing lasts a few samples), contacts never reaching 50 N are dropped; heel strike is
+the linear interpolation of the 20 N crossing between the last unloaded and the first loaded
+sample of a contact, toe off between the last loaded and the first unloaded sample. Contacts
+that touch the record's ends have no event there. This "plain" reading is the developers'
+guide's force-plate truth (20 N on the unfiltered vertical force) and gaitfit's default.
 
 - WBDS subject 04 (Fukuchi, Fukuchi & Duarte 2018, PeerJ 6:e4640, CC BY 4.0): 300 Hz, one belt
   per foot; the belt carrying the right foot is the one whose mean centre of pressure (loaded
@@ -18,14 +19,15 @@ unloaded sample. Runs that touch the record's ends have no event there.
 
 Double support (the walking paper's t_ds, one period) for WBDS: from each heel strike to the
 other foot's next toe off, when no toe off of the same foot comes first. The variant
-`naive` (no joining: a contact ends at the first zero sample of the unloading tail) is printed
-for comparison with figures computed that way, and written beside the joined figure.
+`bridged` (every run kept, runs less than 50 ms apart joined: the fragments of an unloading
+tail after an exported zero extend the contact; gaitfit's `--bridge-dropouts`) is printed and
+written beside it (wbds04_force_events_bridged.csv, bridged_double_support_mean_s).
 
-Why the dropouts are joined (printed as "dropout evidence"; issue 19 quotes WBDS04 double
-support 0.070/0.060/0.050/0.047 s, which is what ending a contact at the first zeroed sample
-gives, within 4 ms): the WBDS export zeroes every channel of a belt together (force, moment, and
-the centre of pressure set to one fixed point) on some samples, and in the unloading tail the
-samples it leaves nonzero are the foot's load, not noise:
+The case for bridging (printed as "dropout evidence"; issue 19 quotes WBDS04 double support
+0.070/0.060/0.050/0.047 s, the plain reading within 4 ms): the WBDS export zeroes every
+channel of a belt together (force, moment, and the centre of pressure set to one fixed point)
+on some samples, and in the unloading tail the samples it leaves nonzero look like the foot's
+load, not noise:
   - nonzero samples after the first zero fall monotonically (267 of 270 consecutive pairs on the
     four trials): a tail still unloading, not noise around zero;
   - they occur only within ~30 ms of the cut (46 % of the 2nd sample after the last loaded one,
@@ -33,13 +35,14 @@ samples it leaves nonzero are the foot's load, not noise:
   - at the first zero the foot's force drops by ~100 N in one sample (5× the tail's rate before)
     while the other belt's force changes by its usual amount, i.e. the body's vertical force
     would drop by 100 N in 3.3 ms and come back on the next nonzero sample.
-So the foot is still loaded until the last of those samples; the zeros hide it, and ending the
-contact there shortens the mean double support by 8–16 ms (T08–T05).
+So the foot is probably still loaded until the last of those samples; ending the contact at the
+zero shortens the mean double support by 8–16 ms (T08–T05). The truth stays the plain reading
+(the guide's definition; the issue's figures); gaitfit warns when a batch has such dropouts.
 
 Run from the repository root (shared data in ../shared/data or $GAITFIT_SHARED_DATA):
     /work/venv/bin/python tools/events/force_truth.py
-It writes, beside this script, wbds04_force_events.csv and hamner_force_events.csv (every
-event) and wbds04_double_support.csv (per trial); tests/events_force_timing.rs compares
+It writes, beside this script, wbds04_force_events.csv, wbds04_force_events_bridged.csv and
+hamner_force_events.csv (every event) and wbds04_double_support.csv (per trial); tests/events_force_timing.rs compares
 gaitfit with them.
 """
 import csv
@@ -70,14 +73,25 @@ def runs(mask):
     return list(zip(np.where(d == 1)[0], np.where(d == -1)[0] - 1))
 
 
-def events(t, force, min_gap_s=MIN_GAP_S):
-    """Heel strikes and toe offs (s) of one foot's raw vertical force sampled at times t."""
+def events(t, force, bridged=False):
+    """Heel strikes and toe offs (s) of one foot's raw vertical force sampled at times t.
+
+    Plain (the default, the guide's truth): the runs above 20 N lasting at least 50 ms (shorter
+    ones are blips, unless the record cuts them) make the contacts, runs less than 50 ms apart
+    taken as one contact (no swing lasts a few samples); heel strike where the first run of a
+    contact rises through 20 N, toe off where its last falls through it. A zeroed sample in an
+    unloading tail therefore ends the contact (the tail's later fragments are blips).
+    Bridged: every run is kept and runs less than 50 ms apart are joined, so the fragments of
+    an unloading tail after a zeroed sample extend the contact.
+    """
     base = np.median(force[force < LEVEL_N])
     g = force - base
     n = len(g)
+    kept = [(s, e) for s, e in runs(g > LEVEL_N)
+            if bridged or t[e] - t[s] >= MIN_RUN_S or s == 0 or e == n - 1]
     joined = []
-    for s, e in runs(g > LEVEL_N):
-        if joined and t[s] - t[joined[-1][1]] < min_gap_s:
+    for s, e in kept:
+        if joined and t[s] - t[joined[-1][1]] < MIN_GAP_S:
             joined[-1] = (joined[-1][0], e)
         else:
             joined.append((s, e))
@@ -137,9 +151,9 @@ def dropout_evidence(data):
 
 
 def wbds(root):
-    rows, summary = [], []
+    rows, brows, summary = [], [], []
     ev_tot = [0, 0, np.zeros(12), np.zeros(12), 0, 0]
-    print("WBDS04 double support, s (mean ± SD): joined dropouts | naive")
+    print("WBDS04 double support, s (mean ± SD): plain (20 N, the truth) | dropouts bridged")
     for k in (5, 6, 7, 8):
         name = f"WBDS04walkT0{k}grf.txt"
         data = np.genfromtxt(os.path.join(root, "wbds", name), delimiter="\t", names=True)
@@ -150,22 +164,23 @@ def wbds(root):
         for i, x in enumerate(dropout_evidence(data)):
             ev_tot[i] = ev_tot[i] + x
         res = {}
-        for variant, gap in (("joined", MIN_GAP_S), ("naive", 0.0)):
+        for variant in ("plain", "bridged"):
             ev = []
             for b in (1, 2):
-                hs, to = events(t, data[f"Fy{b}"], gap)
+                hs, to = events(t, data[f"Fy{b}"], variant == "bridged")
                 side = "right" if b == right else "left"
                 ev += [(x, side, "heel_strike") for x in hs]
                 ev += [(x, side, "toe_off") for x in to]
             ev.sort()
             res[variant] = (ev, double_support(ev))
-        ev, ds = res["joined"]
-        naive = res["naive"][1]
+        ev, ds = res["plain"]
+        bridged = res["bridged"][1]
         print(f"  {trial:<14} n {len(ds):3d}  {np.mean(ds):.4f} ± {np.std(ds, ddof=1):.4f}"
-              f"  | {np.mean(naive):.4f} ± {np.std(naive, ddof=1):.4f}")
+              f"  | {np.mean(bridged):.4f} ± {np.std(bridged, ddof=1):.4f}")
         rows += [(trial, side, kind, f"{x:.5f}") for x, side, kind in ev]
+        brows += [(trial, side, kind, f"{x:.5f}") for x, side, kind in res["bridged"][0]]
         summary.append((trial, len(ds), f"{np.mean(ds):.5f}", f"{np.std(ds, ddof=1):.5f}",
-                        len(naive), f"{np.mean(naive):.5f}"))
+                        len(bridged), f"{np.mean(bridged):.5f}"))
     falling, pairs, after, seen, swing_hi, swing_n = ev_tot
     print("dropout evidence (all four trials): nonzero samples after a contact's first zero")
     print(f"  fall monotonically in {falling} of {pairs} consecutive pairs")
@@ -173,9 +188,10 @@ def wbds(root):
           " ".join(f"{a / max(s, 1):.2f}" for a, s in zip(after, seen)))
     print(f"  samples > 20 N in mid swing: {swing_hi} of {swing_n}")
     write("wbds04_force_events.csv", ["trial", "side", "event", "time_s"], rows)
+    write("wbds04_force_events_bridged.csv", ["trial", "side", "event", "time_s"], brows)
     write("wbds04_double_support.csv",
           ["trial", "n", "double_support_mean_s", "double_support_sd_s",
-           "naive_n", "naive_double_support_mean_s"], summary)
+           "bridged_n", "bridged_double_support_mean_s"], summary)
 
 
 def hamner(root):
