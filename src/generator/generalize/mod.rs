@@ -53,9 +53,9 @@ use crate::generator::GenerateError;
 /// `tests/kb_mu_fit.rs`.
 pub const DEFAULT_ALPHA: [f64; 4] = [
     0.0,
-    0.4511971590061217,
-    1.1659972253651565,
-    1.619077948128876,
+    0.4574277229888217,
+    1.161435301139755,
+    1.5280464841385775,
 ];
 
 /// A prototype walk W(S*, sl*) with its μ-functions: the generator of every other step.
