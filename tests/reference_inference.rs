@@ -417,10 +417,15 @@ fn random_intercept_reml_matches_statsmodels_mixedlm() {
                 &format!("{id} se({name})"),
             );
         }
+        // σ_u² = λ σ_e² sits where the REML criterion is flat: −2ℓ ≈ 1.4e3 with a curvature of
+        // ≈ 0.5 per (log λ)², so f64 resolves its minimum only to ≈ √(2·1.4e3·2.2e-16/0.5) ≈
+        // 1e-6 in log λ, i.e. 1e-6 relative in σ_u² for any optimiser (walk-sl-sf on the data
+        // regenerated for the event defaults: gaitfit 1.8e-6 from statsmodels, statsmodels 1.4e-7
+        // from a numpy profile of the criterion). Hence 1e-5 here, 1e-6 elsewhere.
         close(
             m.subject_sd.powi(2),
             num(&want["subject_var"]),
-            1e-6,
+            1e-5,
             &format!("{id} σ_u²"),
         );
         close(
