@@ -135,3 +135,21 @@ def bm_df(x, g, adj, m, ell):
     gm = np.array(cols).T
     lam = np.linalg.eigvalsh(gm.T @ gm)
     return lam.sum() ** 2 / (lam ** 2).sum()
+
+
+def rows(df, gait, cols):
+    """The unflagged rows of one gait with every column in `cols` present, renumbered."""
+    d = df[(df.gait == gait) & (~df.flagged)]
+    return d.dropna(subset=cols).reset_index(drop=True)
+
+
+def write_json(out, path, preview=None):
+    """Writes `out` to `path` (one-space indent, trailing newline) and prints it (the first
+    `preview` characters when given)."""
+    import json
+
+    with open(path, "w") as f:
+        json.dump(out, f, indent=1)
+        f.write("\n")
+    text = json.dumps(out, indent=1)
+    print(text if preview is None else text[:preview])

@@ -16,7 +16,6 @@ intervals for every coefficient and records whether they cover the true β:
 Nothing here reads gaitfit's output. Run: /work/venv/bin/python tools/reference/coverage.py
 (writes tools/reference/coverage.json; a few minutes).
 """
-import json
 import os
 
 import numpy as np
@@ -25,17 +24,12 @@ import scipy.stats
 import statsmodels
 import statsmodels.api as sm
 
-from common import bm_df, bundled, cr2, subject_codes
+from common import bm_df, bundled, cr2, rows, subject_codes, write_json
 
 OUT = os.path.join(os.path.dirname(__file__), "coverage.json")
 REPS = 400
 BOOT = 399
 SEED = 20261207
-
-
-def rows(df, gait, cols):
-    d = df[(df.gait == gait) & (~df.flagged)]
-    return d.dropna(subset=cols).reset_index(drop=True)
 
 
 def components(x, y, g):
@@ -140,10 +134,7 @@ def main():
     out["walk-tds-sf"] = run("walk-tds-sf",
                              np.column_stack([np.ones(len(d)), d.sf.values * 60.0]),
                              d.ds_pct.values, g, rng)
-    with open(OUT, "w") as f:
-        json.dump(out, f, indent=1)
-        f.write("\n")
-    print(json.dumps(out, indent=1))
+    write_json(out, OUT)
 
 
 if __name__ == "__main__":

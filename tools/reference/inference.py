@@ -9,7 +9,6 @@ standard error of a mean of per-subject slopes). Nothing here reads gaitfit's ou
 
 Run: /work/venv/bin/python tools/reference/inference.py  (writes tools/reference/inference.json)
 """
-import json
 import math
 import os
 
@@ -20,14 +19,9 @@ import scipy.stats
 import statsmodels
 import statsmodels.api as sm
 
-from common import ROOT, bm_df, bundled, cr1, cr2, subject_codes
+from common import ROOT, bm_df, bundled, cr1, cr2, rows, subject_codes, write_json
 
 OUT = os.path.join(os.path.dirname(__file__), "inference.json")
-
-
-def rows(df, gait, cols):
-    d = df[(df.gait == gait) & (~df.flagged)]
-    return d.dropna(subset=cols).reset_index(drop=True)
 
 
 def linear(x, y, g):
@@ -325,10 +319,7 @@ def main():
     out["run-tflight-sf"] = tflight(df)
     out["run-sl-v"] = run_sl_v(df)
     out["kb-mu"] = kb_mu(df)
-    with open(OUT, "w") as f:
-        json.dump(out, f, indent=1)
-        f.write("\n")
-    print(json.dumps(out, indent=1)[:3000])
+    write_json(out, OUT, 3000)
 
 
 if __name__ == "__main__":

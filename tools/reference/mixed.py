@@ -20,7 +20,6 @@ here reads gaitfit's output.
 
 Run: /work/venv/bin/python tools/reference/mixed.py  (writes tools/reference/mixed.json)
 """
-import json
 import os
 import warnings
 
@@ -28,14 +27,9 @@ import numpy as np
 import statsmodels
 import statsmodels.api as sm
 
-from common import bundled
+from common import bundled, rows, write_json
 
 OUT = os.path.join(os.path.dirname(__file__), "mixed.json")
-
-
-def rows(df, gait, cols):
-    d = df[(df.gait == gait) & (~df.flagged)]
-    return d.dropna(subset=cols).reset_index(drop=True)
 
 
 def mixed(x, y, groups):
@@ -78,10 +72,7 @@ def main():
     d = rows(df, "walk", ["sl", "sf", "h"])
     out["walk-sl-sf"] = mixed((d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values,
                               d.subject.values)
-    with open(OUT, "w") as f:
-        json.dump(out, f, indent=1)
-        f.write("\n")
-    print(json.dumps(out, indent=1))
+    write_json(out, OUT)
 
 
 if __name__ == "__main__":

@@ -14,21 +14,15 @@ Nothing here reads gaitfit's output.
 
 Run: /work/venv/bin/python tools/reference/robust.py  (writes tools/reference/robust.json)
 """
-import json
 import os
 
 import numpy as np
 import statsmodels
 import statsmodels.api as sm
 
-from common import bundled, subject_codes
+from common import bundled, rows, subject_codes, write_json
 
 OUT = os.path.join(os.path.dirname(__file__), "robust.json")
-
-
-def rows(df, gait, cols):
-    d = df[(df.gait == gait) & (~df.flagged)]
-    return d.dropna(subset=cols).reset_index(drop=True)
 
 
 def rlm(x, y, subjects):
@@ -73,10 +67,7 @@ def main():
     d = rows(df, "walk", ["sl", "sf", "h"])
     out["walk-sl-sf"] = rlm((d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values,
                             d.subject.values)
-    with open(OUT, "w") as f:
-        json.dump(out, f, indent=1)
-        f.write("\n")
-    print(json.dumps(out, indent=1))
+    write_json(out, OUT)
 
 
 if __name__ == "__main__":
