@@ -124,15 +124,84 @@ fn agreement(records: &[FitRecord]) -> String {
          coefficients within ±10 %; the bootstrap standard deviation's own Monte Carlo error is \
          about {mc:.1} % with {b} replicates); so the two do not agree within Monte Carlo error everywhere, and \
          the disagreement is not a numerical fault: with 5–10 unequal subjects neither is exact. \
-         The Monte Carlo above (400 simulated data sets with the bundled designs, Monte Carlo \
-         standard error of a coverage ≈ 1.1 %) measured the coverage of nominal 95 % intervals: \
-         walk-sl-sf k — CR1 17.0 %, CR2 with Bell–McCaffrey df 92.8 %, subject bootstrap \
-         85.8 %; walk-tds-sf d0/d1 — CR1 98.8/98.3 %, CR2 100.0/99.5 %, bootstrap 95.5/93.5 %. \
+         {}\
          Where the ratio is far below 1 (run-tflight-sf's polynomial coefficients), the analytic \
          standard error is conditional on an irregular k1 and the bootstrap, which refits k1, is \
          the interval to read; where it is above 1 (walk-tds-sf d0), CR2 is the conservative one.",
-        per.join(", ")
+        per.join(", "),
+        coverage_sentence(records),
     )
+}
+
+/// The committed Monte Carlo coverage study (`tools/reference/coverage.py`), read at build time
+/// so that the report quotes the numbers the script wrote, never a copy of them.
+const COVERAGE_JSON: &str = include_str!("../../tools/reference/coverage.json");
+
+/// One sentence with the coverage the Monte Carlo measured for each relation it studied, quoted
+/// only where the study's design (rows and subjects) is the one fitted here; otherwise it says
+/// that the study must be re-run on this data.
+fn coverage_sentence(records: &[FitRecord]) -> String {
+    let Ok(study) = serde_json::from_str::<serde_json::Value>(COVERAGE_JSON) else {
+        return String::new();
+    };
+    let reps = study["reps"].as_u64().unwrap_or(0);
+    let pct = |v: &serde_json::Value| -> Option<String> {
+        let xs: Vec<String> = v
+            .as_array()?
+            .iter()
+            .map(|x| x.as_f64().map(|f| format!("{:.1}", 100.0 * f)))
+            .collect::<Option<_>>()?;
+        Some(format!("{} %", xs.join("/")))
+    };
+    let mut parts = Vec::new();
+    let mut stale = Vec::new();
+    for r in records {
+        let Some(d) = study.get(&r.relation) else {
+            continue;
+        };
+        let clusters = r.inference.as_ref().map_or(r.n_subjects, |i| i.clusters);
+        if d["n"].as_u64() != Some(r.n as u64) || d["clusters"].as_u64() != Some(clusters as u64) {
+            stale.push(r.relation.clone());
+            continue;
+        }
+        let names: Vec<&str> = r.coefficients.iter().map(|c| c.name.as_str()).collect();
+        let c = &d["coverage"];
+        let (Some(cr1), Some(cr2), Some(boot)) =
+            (pct(&c["cr1"]), pct(&c["cr2_bm"]), pct(&c["bootstrap"]))
+        else {
+            continue;
+        };
+        let se = d["monte_carlo_se_of_coverage"]
+            .as_f64()
+            .map_or(String::new(), |s| format!(", ± {:.1} %", 100.0 * s));
+        let coefs = d["beta"].as_array().map_or(0, |b| b.len()).min(names.len());
+        parts.push(format!(
+            "{} {} — CR1 {cr1}, CR2 with Bell–McCaffrey df {cr2}, subject bootstrap {boot}{se}",
+            r.relation,
+            names[..coefs].join("/")
+        ));
+    }
+    let mut out = String::new();
+    if !parts.is_empty() {
+        out = format!(
+            "The Monte Carlo above ({reps} simulated data sets with these designs; \
+             tools/reference/coverage.json) measured the coverage of nominal 95 % intervals: {}.",
+            parts.join("; ")
+        );
+    }
+    if !stale.is_empty() {
+        let _ = write!(
+            out,
+            " The coverage study was run on a different design than the one fitted here for {} \
+             (rows or subjects differ): re-run tools/reference/coverage.py before reading its \
+             numbers.",
+            stale.join(", ")
+        );
+    }
+    if !out.is_empty() {
+        out.push(' ');
+    }
+    out
 }
 
 /// For a relation whose paper gives no value for some coefficients (Ko–Badler's α: only their
@@ -438,5 +507,35 @@ fn write_figures(s: &mut String, figs: &[Figure]) {
             f.drawn,
             stem = f.stem
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn committed(relation: &str) -> FitRecord {
+        let path = format!("{}/fits/{relation}.json", env!("CARGO_MANIFEST_DIR"));
+        let text = std::fs::read_to_string(&path).expect("committed fit record");
+        serde_json::from_str(&text).expect("a fit record")
+    }
+
+    #[test]
+    fn coverage_is_quoted_from_the_study_only_for_the_design_it_simulated() {
+        let study: serde_json::Value = serde_json::from_str(COVERAGE_JSON).unwrap();
+        let mut rec = committed("walk-sl-sf");
+        rec.n = study["walk-sl-sf"]["n"].as_u64().unwrap() as usize;
+        if let Some(i) = rec.inference.as_mut() {
+            i.clusters = study["walk-sl-sf"]["clusters"].as_u64().unwrap() as usize;
+        }
+        let cr1 = 100.0 * study["walk-sl-sf"]["coverage"]["cr1"][0].as_f64().unwrap();
+        let s = coverage_sentence(std::slice::from_ref(&rec));
+        assert!(s.contains(&format!("walk-sl-sf k — CR1 {cr1:.1} %")), "{s}");
+        assert!(!s.contains("re-run"), "{s}");
+
+        rec.n += 1;
+        let s = coverage_sentence(std::slice::from_ref(&rec));
+        assert!(!s.contains("CR1"), "{s}");
+        assert!(s.contains("re-run tools/reference/coverage.py"), "{s}");
     }
 }
