@@ -115,21 +115,23 @@ events build them) is in the `data/*.csv` tables.
   strikes at frames 28 and 97, toe off at 70): the foot-speed detector finds frames 27.3, 96.3
   and 69.3; Zeni 25.1, 94.2 and 70.2 (stance 0.602 s against his 0.601 s; Zeni 0.646 s).
 - **What the steps are built from, therefore**: per-foot plates (WBDS, Hamner, BMClab run) →
-  force events; Schreiber → the C3D's own events (against the plates −3 ± 7 ms at heel strike,
-  +14 ± 9 ms at toe off, `file_events` below); BMClab walk → the force plates, which saw three
+  force events (20 N on the unfiltered force); Schreiber → the plates' events where the plates
+  saw the event and the C3D's own events elsewhere (`auto` = force-then-reference since issue
+  19's third pass: the files' events against the plates −8.1 ± 6.2 ms at heel strike,
+  +18.2 ± 8.9 ms at toe off, n 24 each); BMClab walk → the force plates, which saw three
   successive steps in each walk; Winter → the foot-speed detector. Zeni events build steps only
-  for running trials with markers alone. Before this, Schreiber's and BMClab's double support
-  came from Zeni events and was inflated by the heel-strike bias (BMClab walk 15.3 % →
+  for running trials with markers alone. Before the first pass, Schreiber's and BMClab's double
+  support came from Zeni events and was inflated by the heel-strike bias (BMClab walk 15.3 % →
   9.5–10.6 % of the cycle).
-- **Double support, WBDS vs Schreiber.** WBDS subject 04 (treadmill, force events) 9.5, 8.9,
-  8.4, 8.4 % of the cycle at 1.30–1.88 m/s; Schreiber self-selected (C4) 11.7–14.5 %, fast
-  (C5) 8.3–13.0 %. Both are in the range reported for healthy adults (each double-support
-  period about 10–12 % of the cycle at self-selected speed, falling with speed). The remaining
-  difference is not an event-method artefact of WBDS: changing the force thresholds from
-  20/50 N to 10/30 N moves WBDS by +0.6 points, to 50/80 N by −1.2 points; the WBDS subject is
-  one tall (1.84 m) treadmill walker at 118–136 steps/min, Schreiber's are six overground
-  walkers at 100–158 steps/min, and the file's toe-off events are +14 ms late, which adds
-  about 1.4 points to Schreiber's double support.
+- **Double support, WBDS vs Schreiber** (the per-step summaries below). WBDS subject 04
+  (treadmill, 20 N on the unfiltered force) 6.5, 6.2, 5.4, 5.7 % of the cycle at 1.31–1.88 m/s;
+  Schreiber self-selected (C4) 10.6–12.8 %, fast (C5) 7.6–11.6 %. Schreiber's lie in the range
+  reported for healthy adults (each double-support period about 10–12 % of the cycle at
+  self-selected speed, falling with speed); WBDS's lie below it, and part of the gap is the
+  export: it zeroes the unloading tail of many contacts (section "WBDS04 double support"
+  below), and bridging those zeros (`--bridge-dropouts`) gives 0.083/0.070/0.061/0.058 s,
+  about 1–2 points more. The rest is the walkers: one tall (1.84 m) treadmill walker at
+  118–136 steps/min against six overground walkers at 100–158 steps/min.
 - **Running.** The Zeni methods are walking methods: on Hamner's subject01 (treadmill, 100 Hz
   markers) heel strike −21 ± 8 ms, toe off +53 ms and mostly beyond the 60 ms tolerance (F1
   0.04): the toe keeps moving back relative to the pelvis after it leaves the belt. The
@@ -151,7 +153,7 @@ printf '\n## Per-step summaries\n'
 run "WBDS subject 04, treadmill, force events (Fukuchi et al. 2018)" wbds --summary
 run "Hamner & Delp (2013): five runners × 2, 3, 4, 5 m/s, treadmill, force events" hamner2013 --summary
 run "BMClab running trial (overground, OpenSim GRF) and walks (overground, force plates), Winter's Table A.1" bmclab/motion_capture_run.trc+bmclab/grf_run.mot bmclab/walk1.trc bmclab/walk2.trc bmclab/WinterTableA1.txt --summary
-run "Schreiber & Moissenet (2019): six walkers, self-selected (C4) and fast (C5), C3D events" schreiber2019 --summary
+run "Schreiber & Moissenet (2019): six walkers, self-selected (C4) and fast (C5), plate events (the C3D's elsewhere)" schreiber2019 --summary
 printf '\n## Kinematic methods vs force-plate events\n\n'
 cat <<'EOF'
 Per event type: matched events n, detection F1 (only where the plates see every contact; `–`
