@@ -6,6 +6,7 @@ use super::body::Body;
 use super::determinants::Determinants;
 use super::foot::FootShape;
 use super::high_level::{Locomotion, PhaseTimes};
+use super::pelvis_drop::PelvisDrop;
 use super::stance::StanceRun;
 use super::stop::Closing;
 use super::swing::SwingRun;
@@ -13,7 +14,7 @@ use super::track::interp_rho;
 use super::virtual_leg::{VirtualLeg, KNEE_SOFT};
 use super::WalkOptions;
 use crate::events::{EventKind, EventSource, Gait, GaitEvent, Side};
-use crate::generator::curves::{smootherstep, smoothstep};
+use crate::generator::curves::smoothstep;
 use crate::generator::ik::leg_ik;
 use crate::generator::motion::{Motion, MotionMetadata};
 use crate::generator::skeleton::{Euler, Joint, Skeleton};
@@ -52,70 +53,6 @@ pub(super) struct StepData {
     pub(super) trail_origin: f64,
     /// How far the drawn pelvis is below the simulated hip over the step.
     pub(super) drop: PelvisDrop,
-}
-
-/// How far the drawn pelvis is lowered below the simulated hip over one step, m: 0 at both heel
-/// strikes, rising C² ([`smootherstep`]) to `height` by `rise` s (where the flat foot's need
-/// starts), held, and falling back from `fall` s (the extension: the heel rises, §4.2) to 0 at
-/// `end` (the next heel strike).
-///
-/// The simulation's stance leg is the paper's sagittal telescope locked at `l1` (§4.2); the
-/// drawn leg is three-dimensional (its hip `dz` beside the foot) and its knee straightens softly
-/// ([`KNEE_SOFT`]): with the hip where the simulation puts it the flat foot is out of the drawn
-/// leg's reach by ≈ `2σ + dz²/2l` (3–6 mm), and the virtual leg would roll it onto its ball. The
-/// drawing lowers the pelvis by that much instead ([`flat_drop`]); the stance simulation takes
-/// nothing from the drawn leg. The swing leg hangs from the lowered pelvis (a kinematic
-/// determinant, as the pelvic list and rotation are), and lands where the simulation's does:
-/// the drop is 0 at heel strike.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct PelvisDrop {
-    /// Largest drop, m.
-    pub(super) height: f64,
-    /// End of the rise from heel strike, s.
-    pub(super) rise: f64,
-    /// Start of the fall, s.
-    pub(super) fall: f64,
-    /// End of the step (the next heel strike), s.
-    pub(super) end: f64,
-}
-
-impl PelvisDrop {
-    /// The drop at `tau` s after heel strike, m.
-    pub(super) fn at(&self, tau: f64) -> f64 {
-        self.rates(tau)[0]
-    }
-
-    /// The drop, its rate and its acceleration at `tau`.
-    pub(super) fn rates(&self, tau: f64) -> [f64; 3] {
-        // smootherstep((t − a)/w) and its first two derivatives in t.
-        let blend = |a: f64, w: f64| {
-            let w = w.max(1e-9);
-            let s = ((tau - a) / w).clamp(0.0, 1.0);
-            [
-                smootherstep(s),
-                30.0 * s * s * (1.0 - s) * (1.0 - s) / w,
-                60.0 * s * (1.0 - s) * (1.0 - 2.0 * s) / (w * w),
-            ]
-        };
-        let u = blend(0.0, self.rise);
-        let f = blend(self.fall, self.end - self.fall);
-        let v = [1.0 - f[0], -f[1], -f[2]];
-        let h = self.height;
-        [
-            h * u[0] * v[0],
-            h * (u[1] * v[0] + u[0] * v[1]),
-            h * (u[2] * v[0] + 2.0 * u[1] * v[1] + u[0] * v[2]),
-        ]
-    }
-}
-
-/// The vertical drop of the hip at `hip` (sagittal x, y; `dz` beside the foot) that puts the
-/// flat ankle at `ankle` within `reach` of it, m (0 when it already is). Where the foot is
-/// farther than `reach` horizontally, the drop that brings the hip down to the ankle's height.
-pub(super) fn flat_drop(hip: [f64; 2], dz: f64, ankle: [f64; 2], reach: f64) -> f64 {
-    let dx = hip[0] - ankle[0];
-    let h = (reach * reach - dx * dx - dz * dz).max(0.0).sqrt();
-    (hip[1] - ankle[1] - h).max(0.0)
 }
 
 pub(super) fn side_z(side: Side, a: &WalkAttributes) -> f64 {
@@ -1060,44 +997,6 @@ mod tests {
         let after = worst_step_ratio(&frames(&s[from..]), floor);
         assert!(before > 5.0, "the rule's kick: {before}");
         assert!(after < 3.0, "smoothed: {after}");
-    }
-
-    #[test]
-    fn the_flat_drop_puts_the_flat_ankle_in_reach_and_blends_c2() {
-        let (ankle, reach) = ([0.1, 0.08], 0.85);
-        // Hip straight above the ankle, 5 cm beside it, 0.85 m up: out of reach by
-        // √(0.85² + 0.05²) − 0.85; the drop brings the 3-D distance back to the reach.
-        let hip = [0.1, 0.93];
-        let d = flat_drop(hip, 0.05, ankle, reach);
-        let dist = |y: f64| ((y - ankle[1]).powi(2) + 0.05f64.powi(2)).sqrt();
-        assert!((dist(hip[1] - d) - reach).abs() < 1e-12);
-        assert!(d > 1e-3 && d < 2e-3, "{d}");
-        // Within reach: no drop.
-        assert_eq!(flat_drop([0.1, 0.5], 0.05, ankle, reach), 0.0);
-        // The drop rises from 0 and falls back to 0 with zero rate at both heel strikes.
-        let p = PelvisDrop {
-            height: 0.005,
-            rise: 0.1,
-            fall: 0.3,
-            end: 0.5,
-        };
-        assert_eq!(p.at(0.0), 0.0);
-        assert_eq!(p.at(0.1), 0.005);
-        assert_eq!(p.at(0.3), 0.005);
-        assert_eq!(p.at(0.5), 0.0);
-        let rate = |t: f64| (p.at(t + 1e-6) - p.at(t - 1e-6)) / 2e-6;
-        for t in [1e-6, 0.1 - 1e-6, 0.3 + 1e-6, 0.5 - 1e-6] {
-            assert!(rate(t).abs() < 1e-6, "{t}: {}", rate(t));
-        }
-        for t in [0.02, 0.05, 0.08, 0.35, 0.45] {
-            let [_, r, acc] = p.rates(t);
-            assert!((r - rate(t)).abs() < 1e-6, "{r} vs {}", rate(t));
-            let acc_fd = (rate(t + 1e-4) - rate(t - 1e-4)) / 2e-4;
-            assert!(
-                (acc - acc_fd).abs() < 1e-4 * acc.abs().max(1.0),
-                "{acc} vs {acc_fd}"
-            );
-        }
     }
 
     #[test]

@@ -25,6 +25,7 @@ pub use super::draw::sagittal_angles;
 use super::draw::*;
 pub use super::first_step::FIRST_TOE_OFF_THIGH;
 use super::first_step::*;
+use super::pelvis_drop::{flat_drop, PelvisDrop};
 pub use super::WalkOptions;
 
 /// What happened in one step: its constraints, the shooting effort and how well each phase met

@@ -60,6 +60,7 @@ pub mod generate;
 pub mod high_level;
 pub mod integrate;
 pub mod lagrange;
+pub mod pelvis_drop;
 pub mod schedule;
 pub mod shooting;
 pub mod stance;
