@@ -153,3 +153,15 @@ def write_json(out, path, preview=None):
         f.write("\n")
     text = json.dumps(out, indent=1)
     print(text if preview is None else text[:preview])
+
+
+def walking_designs(df):
+    """The two walking relations' designs as gaitfit builds them, in this order:
+    (relation id, X, y, subject) for walk-tds-sf (DS % on 1, sf in steps/min) and walk-sl-sf
+    (sl on sf·h, no intercept)."""
+    d = rows(df, "walk", ["sf", "ds_pct"])
+    yield ("walk-tds-sf", np.column_stack([np.ones(len(d)), d.sf.values * 60.0]),
+           d.ds_pct.values, d.subject.values)
+    d = rows(df, "walk", ["sl", "sf", "h"])
+    yield ("walk-sl-sf", (d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values,
+           d.subject.values)

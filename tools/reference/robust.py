@@ -20,7 +20,7 @@ import numpy as np
 import statsmodels
 import statsmodels.api as sm
 
-from common import bundled, rows, subject_codes, write_json
+from common import bundled, subject_codes, walking_designs, write_json
 
 OUT = os.path.join(os.path.dirname(__file__), "robust.json")
 
@@ -61,12 +61,8 @@ def main():
         "script": "tools/reference/robust.py",
         "versions": {"statsmodels": statsmodels.__version__, "numpy": np.__version__},
     }
-    d = rows(df, "walk", ["sf", "ds_pct"])
-    out["walk-tds-sf"] = rlm(np.column_stack([np.ones(len(d)), d.sf.values * 60.0]),
-                             d.ds_pct.values, d.subject.values)
-    d = rows(df, "walk", ["sl", "sf", "h"])
-    out["walk-sl-sf"] = rlm((d.sf.values * 60.0 * d.h.values)[:, None], d.sl.values,
-                            d.subject.values)
+    for name, x, y, subject in walking_designs(df):
+        out[name] = rlm(x, y, subject)
     write_json(out, OUT)
 
 
