@@ -627,23 +627,14 @@ pub fn fit_relation(
     for (i, s) in specs.iter().enumerate() {
         let cited = s.cited.then_some(published[i]);
         let mut rec = CoefficientRecord {
-            name: s.name.to_string(),
-            unit: s.unit.to_string(),
-            value: values[i],
-            std_error: None,
-            ci95: [None, None],
             published: cited,
-            t_test: None,
-            std_error_conditional: None,
-            inference: None,
-            ci95_bootstrap: None,
-            se_bootstrap: None,
             held: if free[i] {
                 None
             } else {
                 held_reason[i].clone()
             },
             flag: bound_flag[i].clone(),
+            ..CoefficientRecord::new(s.name, s.unit, values[i])
         };
         let mut se_df: Option<(f64, f64)> = None;
         if s.kind == ParamKind::Linear {
@@ -739,24 +730,16 @@ pub fn fit_relation(
                 ));
             }
             coefs.push(CoefficientRecord {
-                name: format!("{}[{name}]", e.name),
-                unit: e.unit.to_string(),
-                value: v,
                 std_error: Some(se),
                 ci95: [opt(v - tq * se), opt(v + tq * se)],
-                published: None,
-                t_test: None,
-                std_error_conditional: None,
                 inference: Some(format!(
                     "iid within the subject, conditional on the subjects fitted (t with {df} df): \
                      one subject's rows alone inform its level, so no cluster-robust standard \
                      error exists; the paper gives a range (±{}), not a value",
                     e.paper_bound
                 )),
-                ci95_bootstrap: None,
-                se_bootstrap: None,
-                held: None,
                 flag,
+                ..CoefficientRecord::new(format!("{}[{name}]", e.name), e.unit, v)
             });
         }
         notes.push(format!(

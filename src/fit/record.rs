@@ -62,6 +62,28 @@ pub struct CoefficientRecord {
     pub flag: Option<String>,
 }
 
+impl CoefficientRecord {
+    /// A coefficient with its value only: no standard error, interval, published value, test,
+    /// bootstrap or notes. The fit fills in what it computed (struct update syntax).
+    pub fn new(name: impl Into<String>, unit: impl Into<String>, value: f64) -> Self {
+        Self {
+            name: name.into(),
+            unit: unit.into(),
+            value,
+            std_error: None,
+            ci95: [None, None],
+            published: None,
+            t_test: None,
+            std_error_conditional: None,
+            inference: None,
+            ci95_bootstrap: None,
+            se_bootstrap: None,
+            held: None,
+            flag: None,
+        }
+    }
+}
+
 /// r² and rmse of the published coefficients on the same rows.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PublishedFit {

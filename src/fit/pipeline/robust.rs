@@ -119,25 +119,17 @@ pub(super) fn robust_refit(
         }
         let se = free[i].then(|| rcov[(j, j)].max(0.0).sqrt());
         rc.push(CoefficientRecord {
-            name: s.name.to_string(),
-            unit: s.unit.to_string(),
-            value: rout[j],
             std_error: se,
             ci95: se.map_or([None, None], |se| {
                 [opt(rout[j] - tq * se), opt(rout[j] + tq * se)]
             }),
             published: s.cited.then_some(published[i]),
-            t_test: None,
-            std_error_conditional: None,
-            inference: None,
-            ci95_bootstrap: None,
-            se_bootstrap: None,
             held: if free[i] {
                 None
             } else {
                 held_reason[i].clone()
             },
-            flag: None,
+            ..CoefficientRecord::new(s.name, s.unit, rout[j])
         });
         j += 1;
     }
