@@ -7,13 +7,13 @@ use gaitfit::events::Side;
 use gaitfit::generator::generalize::figure::{metadata, walk_motion, StepPlan};
 use gaitfit::generator::generalize::pose::pose;
 use gaitfit::generator::generalize::prototype::Prototype;
-use gaitfit::generator::generalize::{Anthropometry, Generalizer, DEFAULT_ALPHA};
+use gaitfit::generator::generalize::{default_alpha, Anthropometry, Generalizer};
 use gaitfit::generator::skeleton::Skeleton;
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {
     let p = Prototype::bundled();
-    let g = Generalizer::new(p.walk.clone(), p.mu(DEFAULT_ALPHA).unwrap()).unwrap();
+    let g = Generalizer::new(p.walk.clone(), p.mu(default_alpha()).unwrap()).unwrap();
     let sk = Skeleton::from_height(1.9, 80.0).unwrap();
     let body = Anthropometry::from_figure(sk.anthropometry()).unwrap();
     let duration = 0.55;

@@ -14,7 +14,7 @@ use gaitfit::generator::generalize::compare::{
     compare, generalize_onto, mean_scores, schreiber_strides_with, Landmarks, MeasuredStride,
     Target,
 };
-use gaitfit::generator::generalize::DEFAULT_ALPHA;
+use gaitfit::generator::generalize::default_alpha;
 use gaitfit::shared_data;
 
 fn rms(a: &[f64], b: &[f64]) -> f64 {
@@ -32,7 +32,7 @@ fn naive_direct(strides: &[MeasuredStride]) -> [f64; 4] {
             if a.side != b.side
                 || a.subject == b.subject
                 || a.condition != b.condition
-                || generalize_onto(a, b, DEFAULT_ALPHA).is_err()
+                || generalize_onto(a, b, default_alpha()).is_err()
             {
                 continue;
             }
@@ -64,9 +64,9 @@ fn naive_direct(strides: &[MeasuredStride]) -> [f64; 4] {
 fn carried_variant_against_paper_and_naive_scaling() {
     let root = shared_data::require("schreiber2019");
     let (strides, _failed) =
-        schreiber_strides_with(&root, DEFAULT_ALPHA, Landmarks::LateralMarkers).unwrap();
+        schreiber_strides_with(&root, default_alpha(), Landmarks::LateralMarkers).unwrap();
     assert!(strides.len() >= 20, "only {} strides built", strides.len());
-    let rows = compare(&strides, DEFAULT_ALPHA, Target::Measured);
+    let rows = compare(&strides, default_alpha(), Target::Measured);
     // A pair whose generalization fails (a μ out of its range) is left out of every column.
     let failures: Vec<&String> = rows.iter().flat_map(|r| &r.failures).collect();
     println!("left out: {failures:?}");

@@ -12,7 +12,7 @@
 use gaitfit::generator::generalize::compare::{
     compare, mean_scores, schreiber_strides_with, table_markdown, Landmarks, Target,
 };
-use gaitfit::generator::generalize::DEFAULT_ALPHA;
+use gaitfit::generator::generalize::default_alpha;
 use gaitfit::shared_data;
 
 #[test]
@@ -20,15 +20,15 @@ use gaitfit::shared_data;
 fn generalization_against_measured_schreiber_strides() {
     let root = shared_data::require("schreiber2019");
     for landmarks in [Landmarks::LateralMarkers, Landmarks::JointCentres] {
-        let (strides, failed) = schreiber_strides_with(&root, DEFAULT_ALPHA, landmarks).unwrap();
+        let (strides, failed) = schreiber_strides_with(&root, default_alpha(), landmarks).unwrap();
         println!("\n## {landmarks:?}\n");
         for f in &failed {
             println!("not built: {f}");
         }
         assert!(strides.len() >= 20, "only {} strides built", strides.len());
-        let rows = compare(&strides, DEFAULT_ALPHA, Target::Measured);
+        let rows = compare(&strides, default_alpha(), Target::Measured);
         println!("{}", table_markdown(&rows));
-        let model_rows = compare(&strides, DEFAULT_ALPHA, Target::Model);
+        let model_rows = compare(&strides, default_alpha(), Target::Model);
         println!("in model space:\n{}", table_markdown(&model_rows));
         for r in &rows {
             for f in &r.failures {

@@ -9,7 +9,7 @@ use gaitfit::generator::generalize::figure::{
     default_step_duration, metadata, walk_motion, StepPlan,
 };
 use gaitfit::generator::generalize::prototype::Prototype;
-use gaitfit::generator::generalize::{Anthropometry, Generalizer, DEFAULT_ALPHA};
+use gaitfit::generator::generalize::{default_alpha, Anthropometry, Generalizer};
 use gaitfit::generator::skeleton::Skeleton;
 
 fn walk(
@@ -20,7 +20,7 @@ fn walk(
     gaitfit::generator::generalize::figure::FigureReport,
 ) {
     let p = Prototype::bundled();
-    let g = Generalizer::new(p.walk.clone(), p.mu(DEFAULT_ALPHA).unwrap()).unwrap();
+    let g = Generalizer::new(p.walk.clone(), p.mu(default_alpha()).unwrap()).unwrap();
     let sk = Skeleton::from_height(height, 70.0).unwrap();
     let body = Anthropometry::from_figure(sk.anthropometry()).unwrap();
     let d = default_step_duration(p.step_duration_s, &body, &p.walk);

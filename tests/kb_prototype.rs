@@ -3,7 +3,7 @@
 //! column is Winter's subject, in cm), its consistency, the raw table against Winter's filtered
 //! one, and the committed `data/prototype_winter.json` against a fresh build.
 use gaitfit::generator::generalize::prototype::{winter_prototype, Prototype};
-use gaitfit::generator::generalize::{phi_rho, psi, DEFAULT_ALPHA};
+use gaitfit::generator::generalize::{default_alpha, phi_rho, psi};
 use gaitfit::shared_data;
 
 fn rel(got: f64, want: f64) -> f64 {
@@ -41,7 +41,7 @@ fn bundled_prototype_matches_table2_subject() {
 #[test]
 fn bundled_prototype_is_a_fixed_point() {
     let p = Prototype::bundled();
-    let mu = p.mu(DEFAULT_ALPHA).unwrap();
+    let mu = p.mu(default_alpha()).unwrap();
     let d = p
         .walk
         .max_abs_diff(&phi_rho(&p.walk, 1.0, &mu).unwrap())

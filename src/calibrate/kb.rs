@@ -1,7 +1,7 @@
 //! Ko–Badler (1993) in `gaitfit calibrate`: where a walking subject has a measured walk at
 //! another speed, that walk is the subject's own prototype W(S*, sl*) (§2): one of its measured
 //! strides is built into a step W (as `gaitfit generate generalize --build-prototype` does, the
-//! paper's μ-functions with [`DEFAULT_ALPHA`]), generalized (τ = φ∘ψ, eqs. 11–12) to the figure
+//! paper's μ-functions with [`default_alpha()`]), generalized (τ = φ∘ψ, eqs. 11–12) to the figure
 //! of the subject's body height and to the other condition's measured step length and step
 //! duration, rendered, and measured by the same event pipeline as the trials. Nothing is
 //! calibrated: the generator's input is the subject's own other walk, so its residuals show
@@ -18,7 +18,7 @@ use crate::generator::generalize::compare::{
     compare, mean_scores, measured_stride, schreiber_leg, MeanScores, MeasuredStride, Target,
 };
 use crate::generator::generalize::figure::{metadata, walk_motion, StepPlan};
-use crate::generator::generalize::{Generalizer, DEFAULT_ALPHA};
+use crate::generator::generalize::{default_alpha, Generalizer};
 use crate::generator::skeleton::Skeleton;
 use crate::ingest::{read_trial, ReadOptions};
 
@@ -58,7 +58,7 @@ pub fn drive_kb(
     let mut why = Vec::new();
     for side in [Side::Right, Side::Left] {
         let built = schreiber_leg(&trial, side).and_then(|(leg, ev)| {
-            measured_stride(&leg, &ev, DEFAULT_ALPHA, &subject.name, &src.trial, side)
+            measured_stride(&leg, &ev, default_alpha(), &subject.name, &src.trial, side)
         });
         let stride = match built {
             Ok(s) => s,
@@ -69,7 +69,7 @@ pub fn drive_kb(
         };
         let g = stride
             .prototype
-            .mu(DEFAULT_ALPHA)
+            .mu(default_alpha())
             .and_then(|mu| Generalizer::new(stride.prototype.walk.clone(), mu))
             .map_err(|e| e.to_string())?;
         let plan = vec![
@@ -132,7 +132,7 @@ pub fn leave_one_out(subjects: &[&Subject]) -> Option<KbLeaveOneOut> {
             };
             for side in [Side::Left, Side::Right] {
                 if let Ok(m) = schreiber_leg(&trial, side).and_then(|(leg, ev)| {
-                    measured_stride(&leg, &ev, DEFAULT_ALPHA, &s.name, &c.trial, side)
+                    measured_stride(&leg, &ev, default_alpha(), &s.name, &c.trial, side)
                 }) {
                     strides.push(m);
                 }
@@ -153,7 +153,7 @@ pub fn leave_one_out(subjects: &[&Subject]) -> Option<KbLeaveOneOut> {
             m.condition = c.to_string();
         }
     }
-    let rows = compare(&strides, DEFAULT_ALPHA, Target::Measured);
+    let rows = compare(&strides, default_alpha(), Target::Measured);
     let left_out = rows
         .iter()
         .flat_map(|r| &r.failures)

@@ -247,6 +247,12 @@ impl KbMu {
         expect_id(&set, ID, path)?;
         Self::from_coefficients(&set)
     }
+    /// As [`KbMu::from_fit_file`], from the file's JSON text (`path` names it in messages).
+    pub fn from_fit_json(path: &Path, text: &str) -> Result<Self, RelationError> {
+        let set = CoefficientSet::from_fit_json(path, text)?;
+        expect_id(&set, ID, path)?;
+        Self::from_coefficients(&set)
+    }
     /// α₁…α₄ (rad/m).
     pub fn alpha(&self) -> [f64; 4] {
         [

@@ -25,7 +25,7 @@ use crate::generator::generalize::figure::{
     default_step_duration, metadata, walk_motion, StepPlan,
 };
 use crate::generator::generalize::prototype::Prototype;
-use crate::generator::generalize::{Anthropometry as KbBody, Generalizer, DEFAULT_ALPHA};
+use crate::generator::generalize::{default_alpha, Anthropometry as KbBody, Generalizer};
 use crate::generator::motion::Motion;
 use crate::generator::running::attributes::SPECS;
 use crate::generator::running::equations::RunRelations;
@@ -696,7 +696,7 @@ fn generalize(req: &StudioRequest, src: &Sources) -> Result<Generated, StudioErr
     let mass = req.values.get(MASS).copied().unwrap_or(70.0);
     let proto = Prototype::bundled();
     let (alpha, source) = match req.relations {
-        RelationsChoice::Published => (DEFAULT_ALPHA, "built-in α (the committed kb-mu fit)"),
+        RelationsChoice::Published => (default_alpha(), "built-in α (the committed kb-mu fit)"),
         RelationsChoice::Refit => (kb_alpha(&src.fits.join("kb-mu.json"))?, "refit kb-mu.json"),
     };
     let mu = proto.mu(alpha)?;

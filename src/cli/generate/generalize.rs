@@ -21,7 +21,7 @@ use crate::generator::generalize::figure::{
     default_step_duration, metadata, walk_motion, StepPlan,
 };
 use crate::generator::generalize::prototype::{winter_prototype, Prototype};
-use crate::generator::generalize::{Anthropometry, Generalizer, DEFAULT_ALPHA};
+use crate::generator::generalize::{default_alpha, Anthropometry, Generalizer};
 use crate::generator::schedule::Schedule;
 use crate::generator::skeleton::Skeleton;
 use crate::ingest::trials::StepRow;
@@ -262,7 +262,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
 
     let alpha = match &args.alpha {
         Some(a) => parse_alpha(a)?,
-        None => alpha_from_fit(&args.mu_fit)?.unwrap_or(DEFAULT_ALPHA),
+        None => alpha_from_fit(&args.mu_fit)?.unwrap_or(default_alpha()),
     };
     let mu = proto.mu(alpha)?;
     let g = Generalizer::new(proto.walk.clone(), mu)?;

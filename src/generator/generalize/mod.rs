@@ -47,16 +47,27 @@ pub use walk_data::{AngleSequence, Anthropometry, Moments, PathSequence, TimedSe
 
 use crate::generator::GenerateError;
 
-/// The μ-function slopes α₁…α₄ (rad/m) used when no fit is given: the values of the committed
-/// `fits/kb-mu.json` (relation `kb-mu`, fitted by `gaitfit fit` on the bundled trials tables; α₁ sits on its
-/// lower bound 0 — measured knees flex *more* at heel strike in longer steps), checked by
-/// `tests/kb_mu_fit.rs`.
-pub const DEFAULT_ALPHA: [f64; 4] = [
-    0.0,
-    0.4574277229888217,
-    1.161435301139755,
-    1.5280464841385775,
-];
+/// The committed fit `fits/kb-mu.json` (relation `kb-mu`, written by `gaitfit fit` on the
+/// bundled trials tables), compiled in: [`default_alpha`] reads its α from here, so the built-in
+/// slopes are whatever the committed fit says, never a copy of it.
+const COMMITTED_KB_MU_FIT: &str = include_str!("../../../fits/kb-mu.json");
+
+/// The μ-function slopes α₁…α₄ (rad/m) used when no fit is given: those of the committed
+/// `fits/kb-mu.json`, parsed once (on these data α₁ sits on its lower bound 0 — measured knees
+/// flex *more* at heel strike in longer steps). `tests/kb_mu_fit.rs` checks them against the
+/// bounded least-squares optimum computed independently from the bundled tables.
+pub fn default_alpha() -> [f64; 4] {
+    static ALPHA: std::sync::OnceLock<[f64; 4]> = std::sync::OnceLock::new();
+    *ALPHA.get_or_init(|| {
+        crate::relations::kb_mu::KbMu::from_fit_json(
+            std::path::Path::new("fits/kb-mu.json"),
+            COMMITTED_KB_MU_FIT,
+        )
+        .map(|r| r.alpha())
+        // Compiled in from the repository, not user input; the unit test below parses it.
+        .expect("the committed fits/kb-mu.json is a kb-mu fit")
+    })
+}
 
 /// A prototype walk W(S*, sl*) with its μ-functions: the generator of every other step.
 #[derive(Debug, Clone)]
@@ -141,5 +152,16 @@ impl Generalizer {
             before = sl;
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_committed_fit_parses_into_bounded_slopes() {
+        let a = default_alpha();
+        assert!(a.iter().all(|x| x.is_finite() && *x >= 0.0), "{a:?}");
     }
 }
