@@ -206,8 +206,9 @@ cat <<'EOF'
 Made by `/work/venv/bin/python tools/events/gaitkit_side_by_side.py` (optional, not CI; its
 output is committed as `tools/events/gaitkit_side_by_side.txt` and copied here). Both tools
 are scored by the script the same way: every plate event inside the marker record, ends
-included, 60 ms matching. Walking reference: gaitfit's plate events on Schreiber; running
-reference: `tools/events/hamner_force_events.csv` (numpy, no gaitfit). gaitfit `kinematic` is
+included, 60 ms matching. Walking reference: `tools/events/schreiber_force_events.csv`
+(ezc3d's plate extraction + numpy, no gaitfit; gaitfit's plate events agree within 0.01 ms);
+running reference: `tools/events/hamner_force_events.csv` (numpy, no gaitfit). gaitfit `kinematic` is
 foot_speed for walks and foot_jerk for runs; s/trial is per file, gaitfit one process for all
 files, gaitkit per call in Python. On Hamner gaitkit's angle-based methods get proxy ankle and
 knee points (no malleoli or epicondyles in those TRCs); zeni is its running default.

@@ -1,7 +1,10 @@
 //! Walking events from markers alone (issue 19): `--events kinematic` (foot_speed for a walk,
-//! told from the data) against the force-plate events (20 N on the unfiltered force, whose
-//! timing tests/events_force_timing.rs checks against numpy), every plate event inside the
-//! marker record scored. Each Schreiber & Moissenet (2019) record starts about 0.05 s before a
+//! told from the data) against the force-plate events (20 N on the unfiltered force), every
+//! plate event inside the marker record scored. Schreiber's plate events are read from
+//! `tools/events/schreiber_force_events.csv` (tools/events/force_truth.py: ezc3d's plate
+//! extraction and numpy, no gaitfit; gaitfit's own plate events agree within 0.01 ms,
+//! tests/events_force_timing.rs); the BMClab walks' are gaitfit's (the `.forces` export has no
+//! independent reader here). Each Schreiber & Moissenet (2019) record starts about 0.05 s before a
 //! plate heel strike, which the Zeni seeds cannot see.
 //!
 //! Sets: Schreiber subjects 2014001/2014004/2014007 ("train": where the alternative heel-strike
@@ -15,7 +18,9 @@
 //! and the mean on every set, with a held-out SD of 17 ms; both are measured here. On BMClab
 //! the default's heel strike is 16.6 ms early on average, past the 15 ms aim.
 use gaitfit::events::compare::{compare, Coverage, KindCounts, DEFAULT_TOLERANCE_S};
-use gaitfit::events::{analyse, EventKind, EventOptions, EventSource, PrimarySource};
+use gaitfit::events::{
+    analyse, EventKind, EventOptions, EventSource, GaitEvent, PrimarySource, Side,
+};
 use gaitfit::ingest::{read_trial, ReadOptions};
 use gaitfit::shared_data::require;
 use std::collections::BTreeMap;
@@ -34,6 +39,35 @@ fn schreiber(subjects: &[&str]) -> Vec<PathBuf> {
     files
 }
 
+/// The script's plate events of a Schreiber trial (file stem), or `None` for another data set.
+fn script_plates(path: &std::path::Path) -> Option<Vec<GaitEvent>> {
+    if path.extension().is_none_or(|e| e != "c3d") {
+        return None;
+    }
+    let trial = path.file_stem()?.to_str()?;
+    let csv = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tools/events/schreiber_force_events.csv");
+    let text = std::fs::read_to_string(csv).unwrap();
+    let ev: Vec<GaitEvent> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect::<Vec<_>>())
+        .filter(|r| r[1] == trial)
+        .map(|r| GaitEvent {
+            time_s: r[4].parse().unwrap(),
+            side: Side::parse(r[2]).unwrap(),
+            kind: match r[3] {
+                "heel_strike" => EventKind::HeelStrike,
+                "toe_off" => EventKind::ToeOff,
+                other => panic!("unknown event {other}"),
+            },
+            source: EventSource::Force,
+        })
+        .collect();
+    assert!(!ev.is_empty(), "{trial}: not in schreiber_force_events.csv");
+    Some(ev)
+}
+
 /// Scores every file of a set; returns the counts per event kind and the number of plate
 /// events in the first 0.1 s of a marker record.
 fn score(files: &[PathBuf], hs_fraction: f64) -> (BTreeMap<EventKind, KindCounts>, usize) {
@@ -50,15 +84,11 @@ fn score(files: &[PathBuf], hs_fraction: f64) -> (BTreeMap<EventKind, KindCounts
         assert_eq!(an.events.primary, EventSource::FootSpeed, "{}", f.display());
         let k = an.kinematics.as_ref().unwrap();
         let span = (k.time_s[0], k.time_s[k.time_s.len() - 1]);
-        at_start += an
-            .events
-            .force
-            .iter()
-            .filter(|e| e.time_s < span.0 + 0.1)
-            .count();
+        let plates = script_plates(f).unwrap_or_else(|| an.events.force.clone());
+        at_start += plates.iter().filter(|e| e.time_s < span.0 + 0.1).count();
         let res = compare(
             an.events.primary_events(),
-            &an.events.force,
+            &plates,
             Coverage::MatchedOnly,
             span,
             DEFAULT_TOLERANCE_S,

@@ -16,6 +16,13 @@ guide's force-plate truth (20 N on the unfiltered vertical force) and gaitfit's 
   samples) lies further along +Z (right = forward × up in a right-handed lab frame, forward +X,
   up +Y).
 - Hamner & Delp (2013), as republished by Fox (2024): `R_`/`L_ground_force_vy`, 1000 Hz.
+- Schreiber & Moissenet (2019), the 12 overground C3D trials: two plates, analog 1500 Hz, read
+  by ezc3d's own force-platform extraction (`extract_forceplat_data`: channels, calibration and
+  plate corners → force in the lab frame), not by gaitfit's C3D reader; the vertical force is
+  the lab-Z component (sign taken so that the loaded plate reads positive). Each plate's
+  contact goes to the foot whose heel–second-metatarsal midpoint (markers `*_FCC`, `*_FM2`),
+  averaged over the loaded marker frames, lies nearest the mean centre of pressure. Times from
+  the first sample (analog sample k at k/1500 s, marker frame i at i/100 s).
 
 Double support (the walking paper's t_ds, one period) for WBDS: from each heel strike to the
 other foot's next toe off, when no toe off of the same foot comes first. The variant
@@ -42,8 +49,9 @@ zero shortens the mean double support by 8–16 ms (T08–T05). The truth stays 
 Run from the repository root (shared data in ../shared/data or $GAITFIT_SHARED_DATA):
     /work/venv/bin/python tools/events/force_truth.py
 It writes, beside this script, wbds04_force_events.csv, wbds04_force_events_bridged.csv and
-hamner_force_events.csv (every event) and wbds04_double_support.csv (per trial); tests/events_force_timing.rs compares
-gaitfit with them.
+hamner_force_events.csv and schreiber_force_events.csv (every event) and wbds04_double_support.csv
+(per trial); tests/events_force_timing.rs compares gaitfit's force events with them and
+tests/events_walk_kinematic.rs scores the walking marker events against the Schreiber ones.
 """
 import csv
 import glob
@@ -209,6 +217,40 @@ def hamner(root):
     write("hamner_force_events.csv", ["subject", "trial", "side", "event", "time_s"], rows)
 
 
+def schreiber(root):
+    import ezc3d  # only this data set needs it
+
+    rows = []
+    for path in sorted(glob.glob(os.path.join(root, "schreiber2019", "*", "dynamic", "*.c3d"))):
+        c = ezc3d.c3d(path, extract_forceplat_data=True)
+        par = c["parameters"]
+        rate = float(par["ANALOG"]["RATE"]["value"][0])
+        prate = float(par["POINT"]["RATE"]["value"][0])
+        labels = [x.strip() for x in par["POINT"]["LABELS"]["value"]]
+        pts = c["data"]["points"]
+        foot = {side: 0.5 * (pts[:3, labels.index(f"{p}_FCC")] + pts[:3, labels.index(f"{p}_FM2")])
+                for side, p in (("left", "L"), ("right", "R"))}
+        trial = os.path.basename(path)[: -len(".c3d")]
+        subject = trial.split("_")[0]
+        for plate in c["data"]["platform"]:
+            fz = plate["force"][2]
+            fz = fz if fz.max() >= -fz.min() else -fz
+            t = np.arange(len(fz)) / rate
+            hs, to = events(t, fz)
+            loaded = fz > CONFIRM_N
+            if not loaded.any():
+                continue
+            cop = np.nanmean(plate["center_of_pressure"][:3, loaded], axis=1)
+            frames = np.unique(np.floor(t[loaded] * prate + 0.5).astype(int))
+            frames = frames[frames < pts.shape[2]]
+            dist = {side: np.linalg.norm(np.nanmean(m[:, frames], axis=1) - cop)
+                    for side, m in foot.items()}
+            side = min(dist, key=dist.get)
+            rows += [(subject, trial, side, "heel_strike", f"{x:.5f}") for x in hs]
+            rows += [(subject, trial, side, "toe_off", f"{x:.5f}") for x in to]
+    write("schreiber_force_events.csv", ["subject", "trial", "side", "event", "time_s"], rows)
+
+
 def write(name, header, rows):
     out = os.path.join(HERE, name)
     with open(out, "w", newline="") as f:
@@ -222,3 +264,4 @@ if __name__ == "__main__":
     r = shared()
     wbds(r)
     hamner(r)
+    schreiber(r)

@@ -7,9 +7,9 @@ gaitfit. Run from the repository root (shared data in ../shared/data or $GAITFIT
 
 Data and references (both scored the same way, by this script):
 - Walking: the 12 Schreiber & Moissenet (2019) overground trials (C3D, markers 100 Hz). The
-  reference is the force-plate events gaitfit writes with `--events force --events-out` (20 N
-  on the unfiltered force; tests/events_force_timing.rs checks that timing against numpy on
-  WBDS and Hamner). Plates see only some steps, so only recall and timing are defined there.
+  reference is tools/events/schreiber_force_events.csv from force_truth.py (20 N on the
+  unfiltered force of ezc3d's plate extraction, numpy, no gaitfit). Plates see only some steps,
+  so only recall and timing are defined there.
 - Running: Hamner & Delp (2013) subject01 Run_2–5 (TRC, 100 Hz, treadmill). The reference is
   tools/events/hamner_force_events.csv from force_truth.py (numpy, no gaitfit); the GRF sees
   every contact.
@@ -164,9 +164,9 @@ def main():
     # Walking: Schreiber.
     import gaitkit
     files = sorted(glob.glob(os.path.join(root, "schreiber2019", "*", "dynamic", "*.c3d")))
-    force = gaitfit_events(gaitfit, files, "force", root)
+    force = pd.read_csv(os.path.join(HERE, "schreiber_force_events.csv"))
     ref = {tr: [(r.time_s, r.side, r.event) for r in g.itertuples()]
-           for tr, g in force[force.event.isin(["heel_strike", "toe_off"])].groupby("trial")}
+           for tr, g in force.groupby("trial")}
     for method in ("bike", "zeni", "oconnor", "hreljac"):
         key = ("schreiber", "gaitkit", method)
         t = time.time()
