@@ -58,8 +58,8 @@ use crate::fit::forms::{DistinctKeys, Fitting};
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Fitted, Inputs, ParamKind, Relation};
 use profile::{
-    confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, Profiler,
-    SortedRows, Source, Subset,
+    confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, ProfileGrid,
+    Profiler, SortedRows, Source, Subset,
 };
 
 mod band;
@@ -430,15 +430,22 @@ pub fn fit_relation(
     };
     let rmin = if n_bp > 0 { pr.rss(&p) } else { rss };
     let sigma2_min = rmin / df;
+    // Each breakpoint's profile on the grid, shared by its plain and clustered sets.
+    let grids: Vec<ProfileGrid> = bps
+        .iter()
+        .map(|&i| ProfileGrid::new(&pr, &p, i, &plan.search))
+        .collect();
     let plain: Vec<_> = bps
         .iter()
-        .map(|&i| {
+        .zip(&grids)
+        .map(|(&i, grid)| {
             let set = confidence_set(
                 &pr,
                 &p,
                 i,
                 &plan.search,
                 rmin + sigma2_min * tq_iid * tq_iid,
+                grid,
             );
             set.record(specs[i].name)
         })
@@ -516,7 +523,7 @@ pub fn fit_relation(
             };
             let thr = rmin + sigma2_min * delta * tq_cl * tq_cl;
             let (mut rec, hull) =
-                confidence_set(&pr, &p, i, &plan.search, thr).record(specs[i].name);
+                confidence_set(&pr, &p, i, &plan.search, thr, &grids[b]).record(specs[i].name);
             rec.pieces_iid = plain_rec.pieces;
             rec.design_effect = opt(delta);
             rec.method = format!(

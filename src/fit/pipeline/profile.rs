@@ -425,15 +425,55 @@ impl ConfidenceSet {
     }
 }
 
+/// A continuous breakpoint's profile on the [`PROFILE_GRID`] grid over its search range (and at
+/// the estimate): computed once per breakpoint and shared by its confidence sets (the plain F
+/// set and the clustered one differ only in the threshold). Empty for a discrete breakpoint or
+/// one without a search range.
+pub(super) struct ProfileGrid {
+    ts: Vec<f64>,
+    r: Vec<f64>,
+}
+
+impl ProfileGrid {
+    /// The profile of breakpoint `i` (the others held at `p`), the grid's values evaluated in
+    /// parallel (each is the same number whichever thread computes it).
+    pub fn new(pr: &Profiler, p: &[f64], i: usize, search: &[Option<(f64, f64)>]) -> ProfileGrid {
+        let empty = ProfileGrid {
+            ts: Vec::new(),
+            r: Vec::new(),
+        };
+        let Some((lo, hi)) = search[i] else {
+            return empty;
+        };
+        if pr.discrete(i).is_some() {
+            return empty;
+        }
+        let cells = PROFILE_GRID;
+        let mut ts: Vec<f64> = (0..=cells)
+            .map(|c| lo + (hi - lo) * c as f64 / cells as f64)
+            .collect();
+        if p[i] > lo && p[i] < hi {
+            ts.push(p[i]);
+            ts.sort_by(f64::total_cmp);
+            ts.dedup();
+        }
+        use rayon::prelude::*;
+        let r: Vec<f64> = ts.par_iter().map(|&t| pr.rss_at(p, i, t)).collect();
+        ProfileGrid { ts, r }
+    }
+}
+
 /// The 95 % confidence set of breakpoint `i` (the others held at `p`): the values where the
 /// profile RSS ≤ `thr` = RSS_min·(1 + F(1, df; 0.95)/df), over every admissible partition of
-/// the rows (discrete breakpoints) or a [`PROFILE_GRID`] grid over the whole search range.
+/// the rows (discrete breakpoints) or the grid `grid` ([`ProfileGrid::new`] of the same
+/// `pr`, `p`, `i`, `search`; crossings bisected).
 pub(super) fn confidence_set(
     pr: &Profiler,
     p: &[f64],
     i: usize,
     search: &[Option<(f64, f64)>],
     thr: f64,
+    grid: &ProfileGrid,
 ) -> ConfidenceSet {
     let empty = ConfidenceSet {
         discrete: pr.discrete(i).is_some(),
@@ -451,15 +491,7 @@ pub(super) fn confidence_set(
     }
     let rss = |t: f64| pr.rss_at(p, i, t);
     let cells = PROFILE_GRID;
-    let mut ts: Vec<f64> = (0..=cells)
-        .map(|c| lo + (hi - lo) * c as f64 / cells as f64)
-        .collect();
-    if p[i] > lo && p[i] < hi {
-        ts.push(p[i]);
-        ts.sort_by(f64::total_cmp);
-        ts.dedup();
-    }
-    let r: Vec<f64> = ts.iter().map(|&t| rss(t)).collect();
+    let (ts, r) = (&grid.ts, &grid.r);
     let ok: Vec<bool> = r.iter().map(|&v| v <= thr).collect();
     let tol = 1e-3 * (hi - lo) / cells as f64;
     // The crossing between an accepted `a` and a rejected `b`.

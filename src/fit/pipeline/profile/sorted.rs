@@ -11,6 +11,10 @@ use crate::relations::Observation;
 use nalgebra::DVector;
 use std::sync::OnceLock;
 
+/// Subjects from which an evaluation with a per-subject column sums the subjects in parallel
+/// (below, the threads' overhead outweighs the work).
+const PAR_SUBJECTS: usize = 64;
+
 /// Rows per leaf of a [`Tree`]: leaves partly inside a queried interval are summed row by row.
 const LEAF: usize = 8;
 
@@ -502,14 +506,28 @@ pub(super) fn solve_sorted(
     match lay.subj_col {
         // A per-subject column: each subject's normal equations, that column absorbed, summed.
         Some(_) => {
-            for (s, mult) in members.list(sr.subj.len()) {
+            let list = members.list(sr.subj.len());
+            let subject = |s: usize| {
                 let one = [(s, 1.0)];
                 let q = Query {
                     sr,
                     members: Members::List(&one),
                     remove,
                 };
-                t.add(&absorbed(&q, p, lay)?, mult);
+                absorbed(&q, p, lay)
+            };
+            if list.len() >= PAR_SUBJECTS {
+                // The subjects' sums in parallel, added in subject order: the same number.
+                use rayon::prelude::*;
+                let sums: Vec<Option<SubjectSums>> =
+                    list.par_iter().map(|&(s, _)| subject(s)).collect();
+                for (x, &(_, mult)) in sums.iter().zip(&list) {
+                    t.add(x.as_ref()?, mult);
+                }
+            } else {
+                for (s, mult) in list {
+                    t.add(&subject(s)?, mult);
+                }
             }
         }
         None => {
