@@ -6,7 +6,7 @@ use super::body::Body;
 use super::determinants::Determinants;
 use super::foot::FootShape;
 use super::high_level::{Locomotion, PhaseTimes};
-use super::pelvis_drop::PelvisDrop;
+use super::pelvis_drop::PelvisLowering;
 use super::stance::StanceRun;
 use super::stop::Closing;
 use super::swing::SwingRun;
@@ -52,7 +52,7 @@ pub(super) struct StepData {
     /// Global time of the trailing leg's clock origin, s.
     pub(super) trail_origin: f64,
     /// How far the drawn pelvis is below the simulated hip over the step.
-    pub(super) drop: PelvisDrop,
+    pub(super) drop: PelvisLowering,
 }
 
 pub(super) fn side_z(side: Side, a: &WalkAttributes) -> f64 {

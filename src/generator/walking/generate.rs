@@ -25,7 +25,7 @@ pub use super::draw::sagittal_angles;
 use super::draw::*;
 pub use super::first_step::FIRST_TOE_OFF_THIGH;
 use super::first_step::*;
-use super::pelvis_drop::{flat_drop, PelvisDrop};
+use super::pelvis_drop::{flat_drop, PelvisDrop, PelvisLowering, PELVIS_SMOOTH};
 pub use super::WalkOptions;
 
 /// What happened in one step: its constraints, the shooting effort and how well each phase met
@@ -412,9 +412,27 @@ pub fn generate_steps(
             fall: t_flat_end,
             end: t_step,
         };
+        // The drawn pelvis height: the least-bending curve below the simulated hip lowered by
+        // the flat foot's drop (`PELVIS_SMOOTH`), equal to it at both heel strikes.
+        let lowering = {
+            let n = ((t_step / 2e-3).ceil() as usize).max(8);
+            let h = t_step / n as f64;
+            let times: Vec<f64> = (0..=n).map(|i| h * i as f64).collect();
+            let sim: Vec<f64> = times.iter().map(|&t| stance_hip_sim(t).0[1]).collect();
+            let mut below: Vec<f64> = times
+                .iter()
+                .zip(&sim)
+                .map(|(&t, &y)| drop.at(t) - y)
+                .collect();
+            smooth_roll(&times, &mut below, 0, false, PELVIS_SMOOTH * t_step);
+            let d = (0..=n)
+                .map(|i| (sim[i] + below[i]).max(drop.at(times[i])))
+                .collect();
+            PelvisLowering::from_samples(h, d)
+        };
         let stance_hip = |t: f64| -> ([f64; 2], f64) {
             let (hp, hz) = stance_hip_sim(t);
-            ([hp[0], hp[1] - drop.at(t)], hz)
+            ([hp[0], hp[1] - lowering.at(t)], hz)
         };
         // The swing leg hangs from the drawn pelvis, as from the kinematic pelvic rotation and
         // list (§2: the determinants are injected into the one-hip model): the simulated hip with
@@ -427,7 +445,7 @@ pub fn generate_steps(
                 h.vel[i] += od[i];
                 h.acc[i] += odd[i];
             }
-            let [d, dd, ddd] = drop.rates(t);
+            let [d, dd, ddd] = lowering.rates(t);
             h.pos[1] -= d;
             h.vel[1] -= dd;
             h.acc[1] -= ddd;
@@ -443,7 +461,7 @@ pub fn generate_steps(
         // (the drawn leg reaches the rule's ankle from the lowered pelvis all the same).
         let trail_hip3 = |t: f64| -> ([f64; 2], f64) {
             let (hp, hz) = swing_hip3(t);
-            ([hp[0], hp[1] + drop.at(t)], hz)
+            ([hp[0], hp[1] + lowering.at(t)], hz)
         };
         // 2. The trailing leg completes its stance through the double support.
         let dt_v = 2e-3;
@@ -710,7 +728,7 @@ pub fn generate_steps(
             trail_hips,
             trail_leg,
             trail_origin: t_global - trailing_clock,
-            drop,
+            drop: lowering,
         });
         if recorded {
             t_end = t_global + t_step;

@@ -21,8 +21,9 @@
 //!
 //! **Continuity caveat.** Steady walks of 1–7 km/h × 1.5–2.0 m meet the smoothness check
 //! [`crate::generator::checks::continuity`] at k = 5 (every frame-to-frame step within 5 × the
-//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.45 steady
-//! (the ankle at the second heel strike), 5.29 from standing with a stop, and on a 0.1 km/h ×
+//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.04 steady
+//! (the ankle at a heel strike, frame 306; 5.45 before the drawn pelvis height was smoothed,
+//! [`pelvis_drop`]), 5.29 from standing with a stop, and on a 0.1 km/h ×
 //! 5 cm grid 6.7–7.0 km/h × 1.5–1.6 m (5.04–5.29 on main 40536a7) and 3.3 km/h × 1.55 m (5.02,
 //! the landing knee); 8 steps, 100 frames/s (`tests/klaw_continuity.rs`; 5.45 since the stance
 //! simulation locks at the paper's `l1` and the drawing lowers the pelvis instead,

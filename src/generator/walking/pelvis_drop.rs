@@ -1,6 +1,8 @@
-//! The drawing's pelvis drop: how far the drawn pelvis is lowered below the simulated hip over
-//! a stance so that the flat foot stays within the drawn 3-D leg's soft reach (issue 20 stage A;
-//! the stance simulation takes nothing from the drawn leg).
+//! The drawing's pelvis height: how far the drawn pelvis is lowered below the simulated hip over
+//! a stance so that the flat foot stays within the drawn 3-D leg's soft reach (`PelvisDrop`,
+//! issue 20 stage A; the stance simulation takes nothing from the drawn leg), and the whole
+//! lowering once the drawn height is the least-bending curve below that (`PelvisLowering`,
+//! stage B).
 use crate::generator::curves::smootherstep;
 
 /// How far the drawn pelvis is lowered below the simulated hip over one step, m: 0 at both heel
@@ -67,6 +69,86 @@ pub(super) fn flat_drop(hip: [f64; 2], dz: f64, ankle: [f64; 2], reach: f64) -> 
     (hip[1] - ankle[1] - h).max(0.0)
 }
 
+/// The drawn pelvis's whole lowering below the simulated hip over one step, m: a natural cubic
+/// spline through samples on a uniform grid (C², so the swing leg hanging from the drawn
+/// pelvis gets its rate and acceleration), 0 at both heel strikes. Built by
+/// `generate` from the [`PelvisDrop`] and the least-bending pelvis height below it
+/// (`draw::smooth_roll`; see [`PELVIS_SMOOTH`]).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct PelvisLowering {
+    /// Sample spacing, s.
+    h: f64,
+    /// The lowering at `i h`, m.
+    d: Vec<f64>,
+    /// The spline's second derivative at the samples.
+    m: Vec<f64>,
+}
+
+/// Time scale of the drawn pelvis height's smoothing, as a fraction of the step's duration: the
+/// simulated hip's loading-response dip after heel strike (≈ 0.15 of the step, 5–7 mm) is
+/// drawn as the least-bending curve below it (`draw::smooth_roll`'s `τ`).
+pub const PELVIS_SMOOTH: f64 = 0.08;
+
+impl PelvisLowering {
+    /// The natural cubic spline through `d` (at least 3 samples) spaced `h` s apart.
+    pub(super) fn from_samples(h: f64, d: Vec<f64>) -> Self {
+        let n = d.len();
+        let mut m = vec![0.0; n];
+        if n >= 3 {
+            // Thomas algorithm for m[i−1] + 4 m[i] + m[i+1] = 6 Δ²d[i] / h², m[0] = m[n−1] = 0.
+            let k = n - 2;
+            let mut c = vec![0.0; k];
+            let mut r = vec![0.0; k];
+            for j in 0..k {
+                let i = j + 1;
+                let rhs = 6.0 * (d[i - 1] - 2.0 * d[i] + d[i + 1]) / (h * h);
+                let (cp, rp) = if j == 0 {
+                    (0.0, 0.0)
+                } else {
+                    (c[j - 1], r[j - 1])
+                };
+                let den = 4.0 - cp;
+                c[j] = 1.0 / den;
+                r[j] = (rhs - rp) / den;
+            }
+            for j in (0..k).rev() {
+                let next = if j + 1 < k { m[j + 2] } else { 0.0 };
+                m[j + 1] = r[j] - c[j] * next;
+            }
+        }
+        PelvisLowering { h, d, m }
+    }
+
+    /// The lowering at `tau` s after heel strike, m.
+    pub(super) fn at(&self, tau: f64) -> f64 {
+        self.rates(tau)[0]
+    }
+
+    /// The lowering, its rate and its acceleration at `tau` (held outside the step).
+    pub(super) fn rates(&self, tau: f64) -> [f64; 3] {
+        let n = self.d.len();
+        let end = self.h * (n - 1) as f64;
+        if tau.is_nan() || tau <= 0.0 {
+            return [self.d[0], 0.0, 0.0];
+        }
+        if tau >= end {
+            return [self.d[n - 1], 0.0, 0.0];
+        }
+        let i = ((tau / self.h).floor() as usize).min(n - 2);
+        let h = self.h;
+        let (a, b) = ((i + 1) as f64 * h - tau, tau - i as f64 * h);
+        let (m0, m1, y0, y1) = (self.m[i], self.m[i + 1], self.d[i], self.d[i + 1]);
+        let v = m0 * a.powi(3) / (6.0 * h)
+            + m1 * b.powi(3) / (6.0 * h)
+            + (y0 / h - m0 * h / 6.0) * a
+            + (y1 / h - m1 * h / 6.0) * b;
+        let r = -m0 * a * a / (2.0 * h) + m1 * b * b / (2.0 * h) - (y0 / h - m0 * h / 6.0)
+            + (y1 / h - m1 * h / 6.0);
+        let acc = (m0 * a + m1 * b) / h;
+        [v, r, acc]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -107,5 +189,34 @@ mod tests {
                 "{acc} vs {acc_fd}"
             );
         }
+    }
+
+    #[test]
+    fn the_lowering_interpolates_its_samples_c2() {
+        // Samples of a smooth bump (0 at both ends); the spline passes through them, and its
+        // rate and acceleration are the derivatives of its value.
+        let h = 0.01;
+        let d: Vec<f64> = (0..=50)
+            .map(|i| 0.004 * (std::f64::consts::PI * i as f64 / 50.0).sin().powi(2))
+            .collect();
+        let p = PelvisLowering::from_samples(h, d.clone());
+        for (i, &v) in d.iter().enumerate() {
+            assert!((p.at(h * i as f64) - v).abs() < 1e-12, "{i}");
+        }
+        let value = |t: f64| p.at(t);
+        for t in [0.013, 0.1, 0.2549, 0.37, 0.488] {
+            let [_, r, acc] = p.rates(t);
+            let r_fd = (value(t + 1e-6) - value(t - 1e-6)) / 2e-6;
+            assert!((r - r_fd).abs() < 1e-6, "{t}: {r} vs {r_fd}");
+            let acc_fd = (p.rates(t + 1e-6)[1] - p.rates(t - 1e-6)[1]) / 2e-6;
+            assert!((acc - acc_fd).abs() < 1e-4, "{t}: {acc} vs {acc_fd}");
+        }
+        // The acceleration is continuous across a sample.
+        let [_, _, a0] = p.rates(0.2 - 1e-9);
+        let [_, _, a1] = p.rates(0.2 + 1e-9);
+        assert!((a0 - a1).abs() < 1e-5, "{a0} vs {a1}");
+        // Held outside the step.
+        assert_eq!(p.rates(-0.1), [0.0, 0.0, 0.0]);
+        assert_eq!(p.rates(0.6)[1], 0.0);
     }
 }
