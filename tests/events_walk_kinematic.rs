@@ -16,7 +16,8 @@
 //! NOT met by the default on the held-out Schreiber subjects (11 of 12: 2014015_C4_04's left
 //! heel strike, whose crossing precedes the record). The alternative 0.3 meets recall ≥ 0.99
 //! and the mean on every set, with a held-out SD of 17 ms; both are measured here. On BMClab
-//! the default's heel strike is 16.6 ms early on average, past the 15 ms aim.
+//! the default's heel strike is 16.6 ms early on average, past the 15 ms aim: the bias of a
+//! self-selected walking speed, as on Schreiber's C4 walks (the last test measures it).
 use gaitfit::events::compare::{compare, Coverage, KindCounts, DEFAULT_TOLERANCE_S};
 use gaitfit::events::{
     analyse, EventKind, EventOptions, EventSource, GaitEvent, PrimarySource, Side,
@@ -176,4 +177,76 @@ fn all_twelve_schreiber_trials_meet_the_issue_done_when() {
         "2014001", "2014004", "2014007", "2014014", "2014015", "2014019",
     ]);
     check("schreiber all 12", &files, 12, 10, Some(0.95));
+}
+
+/// Mean walking speed of a set's trials, m/s (the detector's own: median pelvis speed over
+/// the ground, from the Zeni seeds' stances).
+fn mean_speed(files: &[PathBuf]) -> f64 {
+    let opts = EventOptions {
+        primary: PrimarySource::Kinematic,
+        ..EventOptions::default()
+    };
+    let v: Vec<f64> = files
+        .iter()
+        .map(|f| {
+            let t = read_trial(f, &ReadOptions::default()).unwrap();
+            let an = analyse(&t, &opts).unwrap();
+            let k = an.kinematics.as_ref().unwrap();
+            k.ground_and_walking_speed(&an.events.zeni_coordinate)
+                .unwrap()
+                .1
+        })
+        .collect();
+    v.iter().sum::<f64>() / v.len() as f64
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn the_default_heel_strike_bias_follows_walking_speed_not_the_lab() {
+    // BMClab's default heel strike is −16.6 ms (past the 15 ms aim), Schreiber's −12.7 ms.
+    // The BMClab walks are at a self-selected speed (≈1.2 m/s); Schreiber mixes self-selected
+    // (C4) and fast (C5) walks. The heel's speed over the ground when the plate reaches 20 N
+    // is a smaller fraction of the walking speed at the slower speed, so Bonci's fixed 0.5 ×
+    // speed is crossed earlier before the contact: the bias is the speed's, and BMClab's is
+    // that of Schreiber's self-selected walks (another lab, marker set, plate system and frame
+    // rate). Measured: C4 −18.0 ± 11.0 ms at 1.11 m/s, C5 −7.9 ± 7.4 ms at 1.57 m/s, BMClab
+    // −16.6 ± 9.7 ms at 1.17 m/s (the heel at 0.30/0.40/0.31 × speed at the plates' heel
+    // strike, reports/events.md). Asserted: C5 later than C4 by more than 5 ms, BMClab within
+    // two standard errors of C4.
+    let all = schreiber(&[
+        "2014001", "2014004", "2014007", "2014014", "2014015", "2014019",
+    ]);
+    let is = |tag: &str| -> Vec<PathBuf> {
+        all.iter()
+            .filter(|p| p.to_string_lossy().contains(tag))
+            .cloned()
+            .collect()
+    };
+    let b = require("bmclab");
+    let sets = [
+        ("schreiber C4 (self-selected)", is("_C4_")),
+        ("schreiber C5 (fast)", is("_C5_")),
+        (
+            "bmclab walks",
+            vec![b.join("walk1.trc"), b.join("walk2.trc")],
+        ),
+    ];
+    let default = gaitfit::events::kinematic::KinematicOptions::default().hs_speed_fraction;
+    let mut hs = Vec::new();
+    for (name, files) in &sets {
+        let (counts, _) = score(files, default);
+        let c = &counts[&EventKind::HeelStrike];
+        let (m, sd, n) = (c.mean_ms().unwrap(), c.sd_ms().unwrap(), c.tp as f64);
+        let v = mean_speed(files);
+        println!(
+            "{name}: {} trial(s), walking speed {v:.2} m/s, heel strike {m:+.1} ± {sd:.1} ms \
+             (n {n})",
+            files.len()
+        );
+        hs.push((m, sd, n));
+    }
+    let (c4, c5, bm) = (hs[0], hs[1], hs[2]);
+    assert!(c5.0 - c4.0 > 5.0, "C4 {c4:?}, C5 {c5:?}");
+    let se = (c4.1 * c4.1 / c4.2 + bm.1 * bm.1 / bm.2).sqrt();
+    assert!((bm.0 - c4.0).abs() <= 2.0 * se, "C4 {c4:?}, BMClab {bm:?}");
 }
