@@ -15,7 +15,10 @@
 //!   `T₋ₛ(t) = T(t) − Tₛ(t)` (an exact downdate: the absorbed sums are additive over subjects),
 //!   so a fold evaluation costs one subject plus `T(t)`, which every fold shares:
 //!   - on the grid that [`minimize_1d`](crate::fit::nonlinear::minimize_1d) scans (the same for
-//!     every fold whose search range is the whole data's), `T(t)` is summed exactly once;
+//!     every fold whose search range is the whole data's), `T(t)` is summed exactly once; a
+//!     fold whose range is narrower (its subject holds one of the extreme keys) has its own
+//!     grid summed exactly once per range, shared by the folds with that range (before, such a
+//!     fold summed its G − 1 subjects at every one of its ~100 evaluations);
 //!   - elsewhere (Brent's iterates), from a lazily refined model over the search range: a cell
 //!     `[a, b]` with at most [`CELL_ROWS`] rows splits the subjects into those with a key in
 //!     `[a, b]` (summed exactly at every `t`) and the others, whose rows do not change side
@@ -34,7 +37,7 @@ use crate::fit::forms::DistinctKeys;
 use crate::fit::prec::MIN1D_GRID;
 use nalgebra::DVector;
 use std::collections::HashMap;
-use std::sync::{Mutex, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Most rows in a cell of the model (its crossing subjects are summed exactly per evaluation).
 pub const CELL_ROWS: usize = 32;
@@ -87,6 +90,10 @@ impl FoldKeys {
     }
 }
 
+/// Set once a search range's grid is in the exact cache (its first fold sums it; the others
+/// wait for it).
+type GridOnce = Arc<OnceLock<()>>;
+
 /// A cell of the model of `T(t)`.
 struct Cell {
     lo: f64,
@@ -113,6 +120,8 @@ pub(in crate::fit::pipeline) struct FoldEngine<'b> {
     i: usize,
     search: (f64, f64),
     exact: Mutex<HashMap<u64, Totals>>,
+    /// The search ranges whose grids are in `exact` (summed once, by the first fold asking).
+    grids: Mutex<HashMap<(u64, u64), GridOnce>>,
     root: Cell,
 }
 
@@ -163,6 +172,7 @@ impl<'b> FoldEngine<'b> {
             i,
             search,
             exact: Mutex::new(HashMap::new()),
+            grids: Mutex::new(HashMap::new()),
             root: Cell {
                 lo: search.0,
                 hi: search.1,
@@ -171,44 +181,82 @@ impl<'b> FoldEngine<'b> {
                 model: OnceLock::new(),
             },
         };
-        // The grid every fold with this search range scans first (as minimize_1d builds it).
-        let (lo, hi) = search;
-        let h = (hi - lo) / MIN1D_GRID as f64;
-        let grid: Vec<f64> = (0..=MIN1D_GRID)
-            .map(|k| {
-                if k == MIN1D_GRID {
-                    hi
-                } else {
-                    lo + h * k as f64
-                }
-            })
-            .collect();
-        use rayon::prelude::*;
-        let sums: Vec<(u64, Option<Totals>)> = grid
-            .par_iter()
-            .map(|&t| (t.to_bits(), e.sum_exact(t, None)))
-            .collect();
-        {
-            let mut map = e.exact.lock().ok()?;
-            for (k, v) in sums {
-                if let Some(v) = v {
-                    map.insert(k, v);
-                }
-            }
-        }
+        e.sum_grid(search);
         Some(e)
     }
 
+    /// `T(t)` summed exactly on the grid that [`minimize_1d`](crate::fit::nonlinear::minimize_1d)
+    /// scans over `search` (in parallel over the grid), once per range.
+    fn sum_grid(&self, search: (f64, f64)) {
+        let once = {
+            let Ok(mut grids) = self.grids.lock() else {
+                return;
+            };
+            grids
+                .entry((search.0.to_bits(), search.1.to_bits()))
+                .or_default()
+                .clone()
+        };
+        once.get_or_init(|| {
+            // As minimize_1d builds it.
+            let (lo, hi) = search;
+            let h = (hi - lo) / MIN1D_GRID as f64;
+            let grid: Vec<f64> = (0..=MIN1D_GRID)
+                .map(|k| {
+                    if k == MIN1D_GRID {
+                        hi
+                    } else {
+                        lo + h * k as f64
+                    }
+                })
+                .collect();
+            let known: Vec<bool> = match self.exact.lock() {
+                Ok(map) => grid
+                    .iter()
+                    .map(|t| map.contains_key(&t.to_bits()))
+                    .collect(),
+                Err(_) => return,
+            };
+            use rayon::prelude::*;
+            let sums: Vec<(u64, Option<Totals>)> = grid
+                .par_iter()
+                .zip(&known)
+                .filter(|(_, &k)| !k)
+                .map(|(&t, _)| (t.to_bits(), self.sum_exact(t, None)))
+                .collect();
+            if let Ok(mut map) = self.exact.lock() {
+                for (k, v) in sums {
+                    if let Some(v) = v {
+                        map.insert(k, v);
+                    }
+                }
+            }
+        });
+    }
+
     /// Whether a fold with layout `lay`, starting values `p` and search ranges `search` can use
-    /// the engine.
+    /// the engine: the same layout, the same parameters but for the breakpoint, no other free
+    /// breakpoint searched, and the breakpoint's search range inside the engine's. A fold
+    /// whose range differs from the engine's (its subject held one of the extreme keys) has
+    /// its own grid summed exactly here (once per range, shared by the folds with that range);
+    /// its other evaluations use the model, as every fold's do.
     pub fn applies(&self, lay: &Layout, p: &[f64], search: &[Option<(f64, f64)>]) -> bool {
-        *lay == self.lay
-            && search.get(self.i).copied().flatten() == Some(self.search)
+        let Some(range) = search.get(self.i).copied().flatten() else {
+            return false;
+        };
+        let ok = *lay == self.lay
+            && range.0 >= self.search.0
+            && range.1 <= self.search.1
+            && range.0 < range.1
             && self.same_but_i(p)
             && search
                 .iter()
                 .enumerate()
-                .all(|(j, s)| j == self.i || s.is_none() || !lay.free[j])
+                .all(|(j, s)| j == self.i || s.is_none() || !lay.free[j]);
+        if ok && range != self.search {
+            self.sum_grid(range);
+        }
+        ok
     }
 
     fn same_but_i(&self, p: &[f64]) -> bool {
@@ -514,5 +562,72 @@ mod tests {
             }
         }
         assert!(interpolated > 0);
+    }
+    #[test]
+    fn folds_with_a_narrower_search_range_use_the_engine_on_their_own_grid() {
+        let rel = RunSlV::published();
+        let rel: &dyn Relation = &rel;
+        let prep = prepared(12, 300);
+        let form = rel.sorted_profile().expect("sorted");
+        let sr = SortedRows::new(form, &prep, false);
+        let lay = Layout::new(rel, vec![true; 3], 11);
+        let p = [0.14, 0.0046, 395.0];
+        let keys = sr.distinct_keys(&[true; 12]);
+        let search = (keys[2], keys[keys.len() - 3]);
+        let e = FoldEngine::new(&sr, &lay, &p, 2, search).expect("engine");
+        let ranges = |r: (f64, f64)| vec![None, None, Some(r)];
+        let narrow = (keys[3], keys[keys.len() - 4]);
+        assert!(e.applies(&lay, &p, &ranges(search)));
+        assert!(!e.applies(&lay, &p, &ranges((keys[1], search.1))));
+        assert!(!e.applies(&lay, &p, &[None, None, None]));
+        assert!(!e.applies(&lay, &[0.14, 0.0047, 395.0], &ranges(search)));
+        assert!(e.applies(&lay, &p, &ranges(narrow)));
+        // The narrow range's grid (as minimize_1d scans it) is summed exactly, and a fold's sums
+        // there equal the other subjects summed directly.
+        let h = (narrow.1 - narrow.0) / MIN1D_GRID as f64;
+        for k in 0..=MIN1D_GRID {
+            let t = if k == MIN1D_GRID {
+                narrow.1
+            } else {
+                narrow.0 + h * k as f64
+            };
+            assert!(e.exact.lock().expect("lock").contains_key(&t.to_bits()));
+            for s in [0, 7] {
+                let q = [p[0], p[1], t];
+                let (_, r1) = e.solve(&q, s).expect("engine fold");
+                let (_, r2) = super::super::solve_sorted(&sr, &lay, &q, Members::AllBut(s), None)
+                    .expect("direct fold");
+                assert!((r1 - r2).abs() <= 1e-10 * r2, "t = {t}: rss {r1} vs {r2}");
+            }
+        }
+        // A fold whose subject holds an extreme key has its own search range; its refit through
+        // the engine finds the optimum the direct refit finds.
+        let fk = FoldKeys::new(&sr);
+        let s = sr.key_subject[0] as usize;
+        let own = form.plan_sorted(fk.without(s)).search[2].expect("fold range");
+        assert!(own != search, "subject {s} holds the lowest key");
+        let free = vec![true; 3];
+        let via_engine = super::super::refit(
+            rel,
+            &free,
+            &p,
+            super::super::Subset::Fold(&sr, &fk, Some(&e), s),
+        )
+        .expect("engine refit");
+        let direct = super::super::refit(
+            rel,
+            &free,
+            &p,
+            super::super::Subset::Fold(&sr, &fk, None, s),
+        )
+        .expect("direct refit");
+        for j in 0..3 {
+            assert!(
+                (via_engine[j] - direct[j]).abs() <= 1e-6 * direct[j].abs(),
+                "parameter {j}: {} vs {}",
+                via_engine[j],
+                direct[j]
+            );
+        }
     }
 }
