@@ -500,10 +500,11 @@ fn kb_loo_html(l: &super::kb::KbLeaveOneOut) -> String {
          walking subjects generalized (ψ then φ) from every other subject's stride of the same leg \
          and condition, scored against the measured stride: RMS over the normalized stride, mean \
          per target then over targets ({} pair(s) left out: a μ out of its range). <i>Paper</i>: \
-         the angles of W's rigid two-link drawing. <i>Carried</i>: the source's measured-minus-\
-         rendered angle residual carried onto the generalized step — the subject's character the \
-         rigid drawing cannot show; the positions, and so the ankle path and the motion files, are \
-         the paper's. <i>Naive scaling</i>: the source's measured stride unchanged on normalized \
+         the angles of W's rigid two-link drawing. <i>Carried</i>: the source's measured angle \
+         curves kept in W — the generalized step drawn with the paper's feet and the hip placed \
+         where the drawn angles come nearest its rendering plus the source's measured-minus-\
+         rendered residual (what `gaitfit generate generalize --kb-variant carried` draws); the \
+         ankle path is the paper's. <i>Naive scaling</i>: the source's measured stride unchanged on normalized \
          time, its ankle path scaled by the leg-length ratio.</p><table><tr><th>candidate</th>\
          <th>hip (deg)</th><th>knee (deg)</th><th>ankle (deg)</th><th>swing ankle path (cm)</th>\
          </tr>{}{}{}{}</table><p class=\"note\">The carried variant is closer than the paper's but \

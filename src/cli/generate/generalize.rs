@@ -14,11 +14,13 @@
 //! step length), one row per step without `step`/`steps`. Without `--prototype` the bundled
 //! Winter prototype is used; without `--alpha` the μ-function slopes come from
 //! `fits/kb-mu.json` (written by `gaitfit fit`, relation `kb-mu`) when it exists, else from the
-//! built-in values (the committed fit).
+//! built-in values (the committed fit). `--kb-variant carried` draws the carried variant
+//! ([`crate::generator::generalize::carried`]).
 use super::common::{freq_arg, length_arg, Common};
 use crate::events::{Gait, Side};
+use crate::generator::generalize::compare::Variant;
 use crate::generator::generalize::figure::{
-    default_step_duration, metadata, walk_motion, StepPlan,
+    default_step_duration, metadata, walk_motion_with, StepPlan,
 };
 use crate::generator::generalize::prototype::{winter_prototype, Prototype};
 use crate::generator::generalize::{default_alpha, Anthropometry, Generalizer};
@@ -71,6 +73,16 @@ pub struct Options {
     /// √(leg length ratio).
     #[arg(long = "step-freq", visible_alias = "cadence", value_name = "FREQ", value_parser = freq_arg)]
     pub step_freq: Option<f64>,
+    /// Ko–Badler variant: `paper` (W's rigid drawing, eqs. 11–12, 25–48) or `carried` (the
+    /// prototype's measured angle curves kept in W: the paper's feet, the hip placed where the
+    /// drawn angles come nearest the generalized step's rendering plus the prototype's residual;
+    /// the prototype must carry measured angles — the bundled one does).
+    #[arg(
+        long = "kb-variant",
+        value_name = "paper|carried",
+        default_value = "paper"
+    )]
+    pub kb_variant: Variant,
     /// The flags shared by every generator.
     #[command(flatten)]
     pub common: Common,
@@ -273,8 +285,32 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         None => default_step_duration(proto.step_duration_s, &body, &proto.walk),
     };
     let plan = plan_steps(c, args.step_length, default_duration)?;
-    let meta = metadata(&g, args.height, &source);
-    let (motion, report) = walk_motion(&g, skeleton, &plan, Side::Right, c.fps, meta)?;
+    let carried = match args.kb_variant {
+        Variant::Paper => None,
+        Variant::Carried => Some(proto.carried(alpha)?.ok_or_else(|| {
+            anyhow!(
+                "--kb-variant carried: the prototype ({source}) carries no measured angle curves \
+                 (a prototype built by --build-prototype, or the bundled one, has them)"
+            )
+        })?),
+    };
+    let mut meta = metadata(&g, args.height, &source);
+    meta.push(
+        "kb_variant",
+        match args.kb_variant {
+            Variant::Paper => "paper",
+            Variant::Carried => "carried",
+        },
+    );
+    let (motion, report) = walk_motion_with(
+        &g,
+        carried.as_ref(),
+        skeleton,
+        &plan,
+        Side::Right,
+        c.fps,
+        meta,
+    )?;
     c.write_motion(&motion)?;
     if c.steps_out.is_some() {
         let subject = c

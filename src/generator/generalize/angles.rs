@@ -33,7 +33,9 @@ pub struct Angles {
     pub ankle_path: Vec<[f64; 2]>,
 }
 
-fn leg_angles(hip: [f64; 2], knee: [f64; 2], ankle: [f64; 2], foot: f64) -> [f64; 3] {
+/// Thigh, knee and ankle angles (rad, definitions above) of a leg from its hip, knee and ankle
+/// joints and its sole angle.
+pub(super) fn leg_angles(hip: [f64; 2], knee: [f64; 2], ankle: [f64; 2], foot: f64) -> [f64; 3] {
     let thigh = (knee[0] - hip[0]).atan2(hip[1] - knee[1]);
     let shank = (ankle[0] - knee[0]).atan2(knee[1] - ankle[1]);
     [thigh, thigh - shank, foot - shank]
@@ -60,17 +62,23 @@ fn grid(i: usize) -> f64 {
 
 /// The angles W prescribes (rendered by [`pose`]).
 pub fn model_angles(w: &WalkData, mu: &MuFunctions) -> Result<Angles, GenerateError> {
-    let mut a = empty();
     let poses = (0..SAMPLES)
         .map(|i| pose(w, mu, grid(i)))
         .collect::<Result<Vec<_>, _>>()?;
+    Ok(angles_from_poses(w, &poses))
+}
+
+/// The angles of a step drawn as `poses` ([`SAMPLES`] poses on the grid of normalized step time),
+/// and W's swing ankle path.
+pub(super) fn angles_from_poses(w: &WalkData, poses: &[super::pose::StepPose]) -> Angles {
+    let mut a = empty();
     let la = |p: &super::pose::StepPose, l: &LegPose| {
         leg_angles(p.hip, l.knee, l.foot.ankle, l.foot_angle)
     };
-    for p in &poses {
+    for p in poses {
         push(&mut a, la(p, &p.stance));
     }
-    for p in &poses {
+    for p in poses {
         push(&mut a, la(p, &p.swing));
     }
     let tom = w.moments().tom();
@@ -79,7 +87,7 @@ pub fn model_angles(w: &WalkData, mu: &MuFunctions) -> Result<Angles, GenerateEr
         let q = w.ankle().interpolate(tom + grid(i) * (1.0 - tom));
         a.ankle_path.push([q[0] - land[0], q[1] - land[1]]);
     }
-    Ok(a)
+    a
 }
 
 /// The measured angles of the stride `ev` of `leg` (the hip from the same pelvis-centre estimate

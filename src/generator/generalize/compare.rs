@@ -9,12 +9,12 @@
 //! path relative to the landing ankle on normalized swing time. Candidates:
 //! - **generalized**: subject A's measured step W_A (built like the Winter prototype), ψ onto
 //!   B's body and φ onto B's step length (after a step of the same length), rendered;
-//! - **generalized, carried** ([`Variant::Carried`]): the same step, with A's own character
-//!   carried in W — the residual of A's measured angles from A's own rendered step (what the
-//!   rigid two-link drawing of W cannot show of A's knee and ankle curves) is added to the
-//!   generalized step's rendered angles on the same normalized step time (φ and ψ keep the
-//!   moments, so the paper's timing aligns them). φ and ψ still place the feet and hip: the
-//!   positions, and so the ankle path, are the paper's;
+//! - **generalized, carried** ([`Variant::Carried`], [`super::carried`]): the same step, with
+//!   A's own character carried in W — A's measured angle curves are kept with W, and the step is
+//!   drawn with the paper's feet and the hip placed where the drawn angles come nearest the
+//!   generalized step's rendering plus A's residual (measured − A's own rendered step, on the
+//!   same normalized step time: φ and ψ keep the moments). These are the angles
+//!   `gaitfit generate generalize --kb-variant carried` draws; the ankle path is the paper's;
 //! - **naive**: A's measured stride unchanged in angles and time-normalized, its ankle path
 //!   scaled by ll(B)/ll(A) (A's step scaled uniformly in size and time);
 //! - **naive rendered**: A's step W rendered through the same model, unchanged (uniform scaling
@@ -37,16 +37,18 @@
 //! with step length (≈ 3.5 / 4.5 / 4° between the two speeds), less than φ changes them.
 //!
 //! The carried variant (issue 21 item 5, `tests/kb_carried.rs`, lateral markers, 2026-12-07):
-//! hip / knee / ankle RMS 6.1 / 10.6 / 6.5° against the paper's 9.0 / 16.0 / 8.2° and naive
-//! scaling's 5.3 / 7.7 / 5.7°; ankle path 6.3 cm (the paper's) against naive's 9.0 cm. Carrying
+//! hip / knee / ankle RMS 6.2 / 10.2 / 6.8° against the paper's 9.0 / 16.1 / 8.1° and naive
+//! scaling's 5.3 / 7.7 / 5.7°; ankle path 6.4 cm (the paper's) against naive's 9.0 cm. Carrying
 //! the residual removes the model floor, so what is left is what φ and ψ change in the drawn
 //! angles: within one subject between its two speeds they change the stance knee by 7.6° RMS
 //! while the subject's knee changes by 4.5° — eq. 27's linear pinning of the hip heights lowers
-//! the mid-stance hip for longer steps. Two other carried designs were measured and were no
-//! better: the stance knee's rendered curve as the IK's preferred posture (the hip height that
+//! the mid-stance hip for longer steps. Other carried designs measured, none better: the
+//! residual simply added to the rendered angles (not drawable — the feet would move; 6.1 / 10.6
+//! / 6.5°), the stance knee's rendered curve as the IK's preferred posture (the hip height that
 //! gives it, pinned at the ends as eq. 27; 6.5 / 10.6 / 6.3°), and the swing ankle path kept
 //! relative to the hip (6.1 / 10.8 / 6.5°).
 use super::angles::{model_angles, Angles};
+use super::carried::{carried_angles, Carried};
 use super::prototype::{build_prototype, Prototype, SagittalLeg, StrideEvents};
 use super::{phi, psi, Generalizer};
 use crate::events::filter::Butterworth;
@@ -60,8 +62,8 @@ pub enum Variant {
     /// The paper's: the angles are those of W's rigid two-link drawing (eqs. 11–12, 25–48).
     #[default]
     Paper,
-    /// The paper's positions, with the prototype's measured-minus-rendered angle residual
-    /// carried onto the generalized step ([`carried_residual`]).
+    /// The paper's feet, the hip placed so the drawn angles come nearest the generalized step's
+    /// rendering plus the prototype's measured-minus-rendered residual ([`super::carried`]).
     Carried,
 }
 
@@ -398,6 +400,7 @@ pub fn measured_stride(
             step_duration_s: report.step_duration_s,
             source: format!("{subject} {condition} {side}"),
             citation: "Schreiber & Moissenet (2019), Sci Data 6:111".into(),
+            angles: Some(angles.clone()),
         },
         angles,
     })
@@ -450,33 +453,6 @@ pub fn generalize_onto(
     generalize_onto_with(src, dst, alpha, Variant::Paper)
 }
 
-/// The angle curves W carries in the carried variant: `s`'s measured angles minus the angles of
-/// its own step W rendered (hip, knee, ankle over the stride; the ankle path is left empty —
-/// positions are not carried). For a rigid two-link leg this is the part of the subject's
-/// curves the drawing cannot produce from H, F and A.
-pub fn carried_residual(s: &MeasuredStride, alpha: [f64; 4]) -> Result<Angles, GenerateError> {
-    let own = rendered(s, alpha)?;
-    let d = |m: &[f64], o: &[f64]| m.iter().zip(o).map(|(a, b)| a - b).collect::<Vec<_>>();
-    Ok(Angles {
-        hip: d(&s.angles.hip, &own.hip),
-        knee: d(&s.angles.knee, &own.knee),
-        ankle: d(&s.angles.ankle, &own.ankle),
-        ankle_path: Vec::new(),
-    })
-}
-
-/// Adds a carried residual to rendered angles (same normalized step time: φ and ψ keep the
-/// moments FGM, MOM, TOM, so no re-timing is needed).
-pub fn add_residual(rendered: &mut Angles, residual: &Angles) {
-    for (v, r) in [
-        (&mut rendered.hip, &residual.hip),
-        (&mut rendered.knee, &residual.knee),
-        (&mut rendered.ankle, &residual.ankle),
-    ] {
-        v.iter_mut().zip(r).for_each(|(x, d)| *x += d);
-    }
-}
-
 /// Generalizes `src` onto `dst`'s body and step length (τ: ψ then φ) with `variant`.
 pub fn generalize_onto_with(
     src: &MeasuredStride,
@@ -489,11 +465,13 @@ pub fn generalize_onto_with(
     let w = psi(&src.prototype.walk, dst.prototype.walk.body(), &mu)?;
     let sl = dst.prototype.walk.step_length();
     let w = phi(&w, sl / w.step_length(), sl, &mu)?;
-    let mut a = render(&g, &w)?;
-    if variant == Variant::Carried {
-        add_residual(&mut a, &carried_residual(src, alpha)?);
+    match variant {
+        Variant::Paper => render(&g, &w),
+        Variant::Carried => {
+            let c = Carried::from_measured(&src.angles, &src.prototype.walk, &mu)?;
+            carried_angles(&w, &mu, &c)
+        }
     }
-    Ok(a)
 }
 
 /// Naive: `src`'s measured angles, its ankle path scaled by the leg-length ratio.

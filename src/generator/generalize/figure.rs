@@ -13,6 +13,7 @@
 //!   and elbows slightly bent, as in normal walking).
 //! - Trunk upright, pelvis level (W has neither).
 //! - Timing: W is on normalized step time; each step gets its duration from the schedule.
+use super::carried::{carried_pose, Carried};
 use super::pose::{pose, LegPose, StepPose};
 use super::walk_data::{Anthropometry, WalkData};
 use super::Generalizer;
@@ -54,9 +55,24 @@ pub struct FigureReport {
 }
 
 /// Renders the steps of `plan` for `skeleton`, the first step's stance leg on `first_stance`,
-/// at `fps` frames per second.
+/// at `fps` frames per second (the paper's drawing: [`walk_motion_with`] without carried curves).
 pub fn walk_motion(
     g: &Generalizer,
+    skeleton: Skeleton,
+    plan: &[StepPlan],
+    first_stance: Side,
+    fps: f64,
+    metadata: MotionMetadata,
+) -> Result<(Motion, FigureReport), GenerateError> {
+    walk_motion_with(g, None, skeleton, plan, first_stance, fps, metadata)
+}
+
+/// As [`walk_motion`]; with `carried`, every frame is drawn by [`carried_pose`] (the carried
+/// variant: the paper's feet, the hip where the drawn angles come nearest the generalized
+/// step's rendering plus the prototype's residual), else by [`pose`] (the paper's).
+pub fn walk_motion_with(
+    g: &Generalizer,
+    carried: Option<&Carried>,
     skeleton: Skeleton,
     plan: &[StepPlan],
     first_stance: Side,
@@ -110,7 +126,10 @@ pub fn walk_motion(
             k += 1;
         }
         let t = ((time - starts[k].0) / plan[k].duration_s).clamp(0.0, 1.0);
-        let p = pose(&steps[k], mu, t)?;
+        let p = match carried {
+            Some(c) => carried_pose(&steps[k], mu, t, c)?,
+            None => pose(&steps[k], mu, t)?,
+        };
         let stance = if k % 2 == 0 {
             first_stance
         } else {

@@ -8,6 +8,8 @@
 //! - [`mu`]: the μ-functions (appendix A, eqs. 21–24);
 //! - [`mod@phi`]: step-length generalization φ_ρ (appendix B, eqs. 25–40);
 //! - [`mod@psi`]: anthropometry generalization ψ (appendix C, eqs. 41–48);
+//! - [`carried`]: the carried variant — the prototype's measured angle curves kept in W, the hip
+//!   placed so the drawn angles come nearest them with the paper's feet (issue 21 item 5);
 //! - [`geometry`]: foot pivots, leg inverse kinematics, the hip heights of eq. 27;
 //! - [`Generalizer`]: prototype + μ-functions → the combined generalization τ (eqs. 11–12)
 //!   and chains of steps.
@@ -29,6 +31,7 @@
 //!
 //! With these, Theorems 1–5 hold to rounding (property tests to 1e-9).
 pub mod angles;
+pub mod carried;
 pub mod compare;
 pub mod figure;
 pub mod geometry;

@@ -41,6 +41,8 @@
 //!   knee flexion at heel strike), and the raw W is made consistent by φ₁
 //!   (which pins the hip heights, blends F₃ onto the heel-strike angle and maps A onto the
 //!   model's toe-off and heel-strike ankles); [`PrototypeReport`] says how far each end moved.
+use super::angles::{measured_angles, Angles, SAMPLES};
+use super::carried::Carried;
 use super::geometry::{foot_on_pivot, hip_ankle_distance, knee_flexion_for_distance, Pivot};
 use super::mu::MuFunctions;
 use super::phi::phi;
@@ -593,6 +595,11 @@ pub struct Prototype {
     pub source: String,
     /// Whom to cite.
     pub citation: String,
+    /// The measured sagittal angles of the stride W was built from (hip, knee, ankle over the
+    /// stance and swing steps, [`super::angles::measured_angles`]; the ankle path is not kept):
+    /// the curves the carried variant keeps ([`Prototype::carried`]). `None` for a prototype
+    /// file written without them.
+    pub angles: Option<Angles>,
 }
 
 impl Prototype {
@@ -604,6 +611,19 @@ impl Prototype {
             self.walk.step_length(),
             self.walk.body().leg_length(),
         )
+    }
+
+    /// The residual the carried variant keeps: the measured angles minus W rendered with the
+    /// μ-functions of slopes `alpha` ([`Carried::from_measured`]); `None` without measured angles.
+    pub fn carried(&self, alpha: [f64; 4]) -> Result<Option<Carried>, GenerateError> {
+        match &self.angles {
+            Some(a) => Ok(Some(Carried::from_measured(
+                a,
+                &self.walk,
+                &self.mu(alpha)?,
+            )?)),
+            None => Ok(None),
+        }
     }
 
     /// The prototype bundled with gaitfit: Winter's walk (`data/prototype_winter.json`).
@@ -682,12 +702,43 @@ impl Prototype {
         if !(f.step_duration_s.is_finite() && f.step_duration_s > 0.0) {
             return Err(format!("{what}: step_duration_s must be positive"));
         }
+        let angles = match f.measured_angles {
+            Some(m) => {
+                let n = 2 * SAMPLES;
+                if m.samples_per_step != SAMPLES
+                    || m.hip_rad.len() != n
+                    || m.knee_rad.len() != n
+                    || m.ankle_rad.len() != n
+                {
+                    return Err(format!(
+                        "{what}: measured_angles: samples_per_step must be {SAMPLES} and hip_rad, \
+                         knee_rad, ankle_rad hold {n} values each (stance step, then swing step)"
+                    ));
+                }
+                if m.hip_rad
+                    .iter()
+                    .chain(&m.knee_rad)
+                    .chain(&m.ankle_rad)
+                    .any(|v| !v.is_finite())
+                {
+                    return Err(format!("{what}: measured_angles: a value is not finite"));
+                }
+                Some(Angles {
+                    hip: m.hip_rad,
+                    knee: m.knee_rad,
+                    ankle: m.ankle_rad,
+                    ankle_path: Vec::new(),
+                })
+            }
+            None => None,
+        };
         let p = Prototype {
             walk,
             mu_star: f.mu_star_rad,
             step_duration_s: f.step_duration_s,
             source: f.source,
             citation: f.citation,
+            angles,
         };
         p.mu([0.0; 4]).map_err(wrap)?;
         Ok(p)
@@ -744,6 +795,12 @@ impl Prototype {
             foot3: angle(w.foot3()),
             meta: angle(w.meta()),
             ankle: path(w.ankle()),
+            measured_angles: self.angles.as_ref().map(|a| MeasuredAnglesFile {
+                samples_per_step: SAMPLES,
+                hip_rad: a.hip.clone(),
+                knee_rad: a.knee.clone(),
+                ankle_rad: a.ankle.clone(),
+            }),
         };
         // Serializing plain numbers and strings cannot fail.
         serde_json::to_string_pretty(&f).unwrap_or_default() + "\n"
@@ -783,6 +840,19 @@ struct PrototypeFile {
     foot3: AngleFile,
     meta: AngleFile,
     ankle: PathFile,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    measured_angles: Option<MeasuredAnglesFile>,
+}
+
+/// The measured stride angles (rad) on normalized step time: `samples_per_step` points over the
+/// stance step, then as many over the swing step.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeasuredAnglesFile {
+    samples_per_step: usize,
+    hip_rad: Vec<f64>,
+    knee_rad: Vec<f64>,
+    ankle_rad: Vec<f64>,
 }
 
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
@@ -839,6 +909,7 @@ pub fn winter_prototype(
     let trial = crate::ingest::winter::read(path, &crate::ingest::ReadOptions::default())?;
     let (leg, ev) = winter_leg(&trial)?;
     let (walk, mu, report) = build_prototype(&leg, &ev, [0.0; 4])?;
+    let angles = measured_angles(&leg, &ev, walk.step_length())?;
     let file = path
         .file_name()
         .map(|f| f.to_string_lossy().into_owned())
@@ -850,6 +921,7 @@ pub fn winter_prototype(
             step_duration_s: report.step_duration_s,
             source: format!("bmclab/{file} (right leg, frames 28–97; events 28, 70, 97)"),
             citation: WINTER_CITATION.into(),
+            angles: Some(angles),
         },
         report,
     ))

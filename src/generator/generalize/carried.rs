@@ -1,0 +1,358 @@
+//! Ko–Badler with the subject's own angle curves carried in W (issue 21 item 5, the *carried*
+//! variant beside the paper's).
+//!
+//! W(S*, sl*) also carries the prototype's measured sagittal angle curves over its stride (hip,
+//! knee, ankle on normalized step time, as [`super::angles::measured_angles`] defines them). The
+//! rigid two-link drawing of W cannot show all of them (the measured thigh is not rigid, the
+//! pelvis-centre estimate moves): the *residual* is the measured curves minus W's own rendering.
+//! A generalized step τ(W) is drawn with
+//!
+//! - **the feet the paper's**: φ and ψ place them (eqs. 25–48), the stance foot rolls on its
+//!   pivots and the swing ankle follows A, exactly as [`super::pose::pose`] draws them; nothing
+//!   here moves a foot, so the stance foot neither slides nor penetrates and steps chain as in
+//!   the paper;
+//! - **the hip (pelvis) the free variable**: with the pelvis upright, each leg's thigh, knee and
+//!   ankle angles follow from the hip position (two-link IK to its fixed ankle, knee forward; the
+//!   ankle angle from the foot's angle). The hip is the least-squares point
+//!   min over h of Σ_legs Σ_{hip,knee,ankle} (drawn(h) − preferred)², preferred = the generalized
+//!   step's rendered angles plus the prototype's residual at that normalized time (φ and ψ keep
+//!   the moments FGM, MOM, TOM, so the residual needs no re-timing). The three angles weigh
+//!   equally in radians: the comparison scores each angle's RMS, and this is the sum of their
+//!   squares at that instant. The hip stays within leg length of both ankles (it is lowered, as
+//!   the paper's drawing does, where a trial point is out of reach).
+//!
+//! Two constraints (the hip's x and y) against six preferred angles: the drawn angles are the
+//! nearest the paper's feet allow, not the preferred ones. [`carried_angles`] is what the
+//! comparison ([`super::compare`]) scores and what [`super::figure::walk_motion_with`] draws.
+use super::angles::{angles_from_poses, leg_angles, Angles, SAMPLES};
+use super::geometry::{knee_position, P2};
+use super::mu::MuFunctions;
+use super::pose::{pose, LegPose, StepPose};
+use super::walk_data::WalkData;
+use crate::generator::GenerateError;
+
+/// The residual a prototype carries: its measured angles minus its own rendered step, over the
+/// stride (stance step then swing step, [`SAMPLES`] points each, rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Carried {
+    hip: Vec<f64>,
+    knee: Vec<f64>,
+    ankle: Vec<f64>,
+}
+
+impl Carried {
+    /// The residual of `measured` (the prototype's measured stride angles) from `proto` rendered
+    /// with `mu` (the prototype's own μ-functions).
+    pub fn from_measured(
+        measured: &Angles,
+        proto: &WalkData,
+        mu: &MuFunctions,
+    ) -> Result<Carried, GenerateError> {
+        let own = super::angles::model_angles(proto, mu)?;
+        let d = |m: &[f64], o: &[f64]| m.iter().zip(o).map(|(a, b)| a - b).collect::<Vec<_>>();
+        Carried::from_residual(
+            d(&measured.hip, &own.hip),
+            d(&measured.knee, &own.knee),
+            d(&measured.ankle, &own.ankle),
+        )
+    }
+
+    /// A residual given directly (rad, 2·[`SAMPLES`] values each: stance step, then swing step).
+    /// Two samples stand for each of two instants of a leg's stride — mid-stride (end of the
+    /// stance step, start of the swing step) and the stride's ends (a measured stride is not
+    /// exactly periodic) — and each pair is replaced by its mean, so that in a chain a leg's
+    /// preferred angles at the end of one step are those at the start of the next and the hip
+    /// joins across steps.
+    pub fn from_residual(
+        mut hip: Vec<f64>,
+        mut knee: Vec<f64>,
+        mut ankle: Vec<f64>,
+    ) -> Result<Carried, GenerateError> {
+        for (name, v) in [("hip", &hip), ("knee", &knee), ("ankle", &ankle)] {
+            if v.len() != 2 * SAMPLES {
+                return Err(GenerateError::Parameter {
+                    name: format!("carried {name}"),
+                    value: v.len() as f64,
+                    message: format!("needs {} samples (stance and swing step)", 2 * SAMPLES),
+                });
+            }
+            if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+                return Err(GenerateError::Parameter {
+                    name: format!("carried {name}"),
+                    value: v[i],
+                    message: format!("sample {i} is not finite"),
+                });
+            }
+        }
+        for v in [&mut hip, &mut knee, &mut ankle] {
+            for (a, b) in [(SAMPLES - 1, SAMPLES), (2 * SAMPLES - 1, 0)] {
+                let m = 0.5 * (v[a] + v[b]);
+                v[a] = m;
+                v[b] = m;
+            }
+        }
+        Ok(Carried { hip, knee, ankle })
+    }
+
+    /// The residual (hip, knee, ankle; rad) of the stance (`swing` false) or swing leg at
+    /// normalized step time `t` (linear between samples, clamped to [0, 1]).
+    pub fn at(&self, swing: bool, t: f64) -> [f64; 3] {
+        let x = t.clamp(0.0, 1.0) * (SAMPLES - 1) as f64;
+        let i = (x.floor() as usize).min(SAMPLES - 2);
+        let f = x - i as f64;
+        let base = if swing { SAMPLES } else { 0 };
+        let l = |v: &[f64]| v[base + i] + f * (v[base + i + 1] - v[base + i]);
+        [l(&self.hip), l(&self.knee), l(&self.ankle)]
+    }
+}
+
+/// Iteration cap of the hip's least squares (it converges in a few; the cap only bounds work).
+const MAX_ITERS: usize = 60;
+
+/// W sampled at `t` as the carried variant draws it: the paper's feet, the hip at the
+/// least-squares point (see the module docs).
+pub fn carried_pose(
+    w: &WalkData,
+    mu: &MuFunctions,
+    t: f64,
+    carried: &Carried,
+) -> Result<StepPose, GenerateError> {
+    let p0 = pose(w, mu, t)?;
+    if p0.unreachable {
+        return Ok(p0);
+    }
+    let body = w.body();
+    let (st, sw) = (p0.stance, p0.swing);
+    let draw = |h: P2, leg: &LegPose| {
+        let (k, _) = knee_position(body, h, leg.foot.ankle);
+        leg_angles(h, k, leg.foot.ankle, leg.foot_angle)
+    };
+    let (ds, dw) = (carried.at(false, t), carried.at(true, t));
+    let (r0s, r0w) = (draw(p0.hip, &st), draw(p0.hip, &sw));
+    let mut want = [0.0; 6];
+    for j in 0..3 {
+        want[j] = r0s[j] + ds[j];
+        want[3 + j] = r0w[j] + dw[j];
+    }
+    let reach = body.leg_length();
+    let ankles = [st.foot.ankle, sw.foot.ankle];
+    // Onto the reachable set: x within reach of both ankles, then the hip lowered under both
+    // reach circles (lowering keeps a hip above its ankles within reach).
+    let lo = ankles.iter().map(|a| a[0] - reach).fold(f64::MIN, f64::max);
+    let hi = ankles.iter().map(|a| a[0] + reach).fold(f64::MAX, f64::min);
+    let project = |h: P2| -> P2 {
+        let x = h[0].clamp(lo, hi);
+        let y = ankles.iter().fold(h[1], |y, a| {
+            let dx = x - a[0];
+            y.min(a[1] + (reach * reach - dx * dx).max(0.0).sqrt())
+        });
+        [x, y]
+    };
+    let resid = |h: P2| -> [f64; 6] {
+        let (a, b) = (draw(h, &st), draw(h, &sw));
+        let mut r = [0.0; 6];
+        for j in 0..3 {
+            r[j] = a[j] - want[j];
+            r[3 + j] = b[j] - want[3 + j];
+        }
+        r
+    };
+    let cost = |r: &[f64; 6]| r.iter().map(|v| v * v).sum::<f64>();
+    let mut h = project(p0.hip);
+    let mut r = resid(h);
+    let mut f = cost(&r);
+    let mut lambda = 1e-3;
+    // Finite-difference steps (m): x centred; y backwards, since lowering a reachable hip keeps
+    // it reachable (at full reach a forward step would be projected back and read as flat).
+    let e = 1e-7 * reach;
+    for _ in 0..MAX_ITERS {
+        let (rxp, rxm) = (
+            resid(project([h[0] + e, h[1]])),
+            resid(project([h[0] - e, h[1]])),
+        );
+        let rym = resid(project([h[0], h[1] - e]));
+        let mut jac = [[0.0; 2]; 6];
+        for i in 0..6 {
+            jac[i][0] = (rxp[i] - rxm[i]) / (2.0 * e);
+            jac[i][1] = (r[i] - rym[i]) / e;
+        }
+        let (mut a, mut g) = ([[0.0; 2]; 2], [0.0; 2]);
+        for i in 0..6 {
+            for p in 0..2 {
+                g[p] += jac[i][p] * r[i];
+                for q in 0..2 {
+                    a[p][q] += jac[i][p] * jac[i][q];
+                }
+            }
+        }
+        let mut improved = false;
+        while lambda < 1e12 {
+            let m = [
+                [a[0][0] * (1.0 + lambda) + 1e-300, a[0][1]],
+                [a[1][0], a[1][1] * (1.0 + lambda) + 1e-300],
+            ];
+            let det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+            if !(det.is_finite() && det > 0.0) {
+                lambda *= 10.0;
+                continue;
+            }
+            let dx = -(m[1][1] * g[0] - m[0][1] * g[1]) / det;
+            let dy = -(m[0][0] * g[1] - m[1][0] * g[0]) / det;
+            let hn = project([h[0] + dx, h[1] + dy]);
+            let rn = resid(hn);
+            let fn_ = cost(&rn);
+            if fn_ < f {
+                let moved = (hn[0] - h[0]).hypot(hn[1] - h[1]);
+                h = hn;
+                r = rn;
+                f = fn_;
+                lambda = (lambda / 3.0).max(1e-9);
+                improved = moved > 1e-12 * reach;
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    // On a reach boundary (a straight knee) the projected steps above stall short of the
+    // constrained optimum: there it is a one-dimensional minimum along that reach circle.
+    for a in ankles {
+        let (dx, dy) = (h[0] - a[0], h[1] - a[1]);
+        if dx.hypot(dy) < reach * (1.0 - 1e-6) {
+            continue;
+        }
+        let on_circle = |th: f64| project([a[0] + reach * th.sin(), a[1] + reach * th.cos()]);
+        let th0 = dx.atan2(dy);
+        let c = |th: f64| cost(&resid(on_circle(th)));
+        let th = golden_min(c, th0 - BOUNDARY_BRACKET_RAD, th0 + BOUNDARY_BRACKET_RAD);
+        let hn = on_circle(th);
+        let rn = resid(hn);
+        if cost(&rn) < f {
+            h = hn;
+            r = rn;
+            f = cost(&r);
+        }
+    }
+    let (k_st, _) = knee_position(body, h, st.foot.ankle);
+    let (k_sw, _) = knee_position(body, h, sw.foot.ankle);
+    Ok(StepPose {
+        hip: h,
+        stance: LegPose { knee: k_st, ..st },
+        swing: LegPose { knee: k_sw, ..sw },
+        ..p0
+    })
+}
+
+/// Half-width of the search along a reach circle (rad of leg angle, ≈ 4 cm of hip travel): the
+/// solver above ends within millimetres of the optimum; this only bounds the search.
+const BOUNDARY_BRACKET_RAD: f64 = 0.05;
+
+/// Golden-section minimum of `f` on [a, b] (to 1e-13 rad).
+fn golden_min(f: impl Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    while b - a > 1e-13 {
+        if fc < fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - g * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + g * (b - a);
+            fd = f(d);
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// The angles of the step `w` drawn by [`carried_pose`] (the carried variant's candidate in the
+/// comparison), on the same grid and with the same definitions as
+/// [`super::angles::model_angles`]; the ankle path is the paper's.
+pub fn carried_angles(
+    w: &WalkData,
+    mu: &MuFunctions,
+    carried: &Carried,
+) -> Result<Angles, GenerateError> {
+    let poses = (0..SAMPLES)
+        .map(|i| carried_pose(w, mu, i as f64 / (SAMPLES - 1) as f64, carried))
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(angles_from_poses(w, &poses))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::generator::generalize::synthetic::synthetic_walk;
+
+    fn zero() -> Carried {
+        Carried::from_residual(
+            vec![0.0; 2 * SAMPLES],
+            vec![0.0; 2 * SAMPLES],
+            vec![0.0; 2 * SAMPLES],
+        )
+        .unwrap()
+    }
+
+    /// A zero residual asks for W's own rendering: the least squares keeps the paper's hip.
+    #[test]
+    fn zero_residual_is_the_paper_drawing() {
+        for seed in 0..6 {
+            let (w, mu) = synthetic_walk(seed).unwrap();
+            let paper = super::super::angles::model_angles(&w, &mu).unwrap();
+            let c = carried_angles(&w, &mu, &zero()).unwrap();
+            for (a, b) in paper.knee.iter().zip(&c.knee) {
+                assert!((a - b).abs() < 1e-9, "seed {seed}: {a} vs {b}");
+            }
+        }
+    }
+
+    /// The feet stay the paper's, the legs reach them, and a residual the hip can produce is
+    /// produced: drawing W with its hip moved by a known offset gives angles whose residual
+    /// from W's rendering leads back to that hip.
+    #[test]
+    fn a_reachable_preferred_posture_is_found_with_the_feet_unchanged() {
+        for seed in 0..6 {
+            let (w, mu) = synthetic_walk(seed).unwrap();
+            let body = w.body();
+            for &t in &[0.3, 0.45, 0.6] {
+                let p0 = pose(&w, &mu, t).unwrap();
+                let target = [p0.hip[0] + 0.01, p0.hip[1] - 0.02];
+                let draw = |h: P2, leg: &LegPose| {
+                    let (k, _) = knee_position(body, h, leg.foot.ankle);
+                    leg_angles(h, k, leg.foot.ankle, leg.foot_angle)
+                };
+                let (a0, b0) = (draw(p0.hip, &p0.stance), draw(p0.hip, &p0.swing));
+                let (a1, b1) = (draw(target, &p0.stance), draw(target, &p0.swing));
+                // A residual constant in time equal to the change at t.
+                let mk = |j: usize| -> Vec<f64> {
+                    let mut v = vec![a1[j] - a0[j]; SAMPLES];
+                    v.extend(vec![b1[j] - b0[j]; SAMPLES]);
+                    v
+                };
+                let c = Carried::from_residual(mk(0), mk(1), mk(2)).unwrap();
+                let p = carried_pose(&w, &mu, t, &c).unwrap();
+                assert!(
+                    (p.hip[0] - target[0]).hypot(p.hip[1] - target[1]) < 1e-6,
+                    "seed {seed} t {t}: {:?} vs {target:?}",
+                    p.hip
+                );
+                assert_eq!(p.stance.foot, p0.stance.foot);
+                assert_eq!(p.swing.foot, p0.swing.foot);
+                for leg in [&p.stance, &p.swing] {
+                    let thigh = (leg.knee[0] - p.hip[0]).hypot(leg.knee[1] - p.hip[1]);
+                    let shin =
+                        (leg.knee[0] - leg.foot.ankle[0]).hypot(leg.knee[1] - leg.foot.ankle[1]);
+                    assert!((thigh - body.thigh()).abs() < 1e-9);
+                    assert!((shin - body.shin()).abs() < 1e-9);
+                }
+            }
+        }
+    }
+}
