@@ -124,7 +124,7 @@ fn the_stance_heel_stays_down_from_foot_flat_to_heel_off() {
 /// heel off / midstance. Measured on main 9c72f4f (before `generate::SLOW_REST_REACH`): 83 of the
 /// 121 walks hovered 1.5–6.1 mm (1.0–1.8 km/h; 1.5 km/h × 1.5 m 5.78 mm); then one (1.4 km/h ×
 /// 1.6 m, 3.98 mm: heel off at foot flat, the knee ease flexing past the flat foot's knee) until
-/// the eased knee was bounded by the flat foot's (`virtual_leg::KNEE_ROCKER_EASE`): its heel
+/// the eased knee was bounded by the flat foot's (`KNEE_ROCKER_EASE`, deleted in stage B): its heel
 /// then stayed down until 4 frames before the rule's heel-off switch (1.26 mm there). Since the
 /// heel-off event marks where the drawn heel leaves the floor (`generate::drawn_heel_off`) every
 /// one of the 121 walks keeps its heel within 0.25 mm until then. `KNOWN` lists walks allowed

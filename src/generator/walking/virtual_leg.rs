@@ -31,18 +31,8 @@ use std::f64::consts::FRAC_PI_2;
 /// Width of the knee's soft straightening in late stance, m.
 pub const KNEE_SOFT: f64 = 0.0015;
 
-/// Time constant of the knee's eased straightening after foot flat, s.
-pub const KNEE_EASE: f64 = 0.015;
-
-/// Time constant of the knee's ease from a straight-leg landing, s.
-pub const KNEE_LAND_EASE: f64 = 0.03;
-
-/// Time constant of the knee's ease after a planned heel rocker's landing that narrowed the knee's
-/// soft margin ([`VirtualLeg::knee_soft`] below [`KNEE_SOFT`]: slow walks), s.
-pub const KNEE_ROCKER_EASE: f64 = 0.05;
-
-/// The knee was eased ([`KNEE_EASE`]) only when the planned heel rocker narrowed the knee's soft
-/// margin ([`VirtualLeg::knee_soft`]) below this, m.
+/// [`VirtualLeg::plan_heel_rocker`] compares a landing only with landings on the same side of
+/// this soft margin ([`VirtualLeg::knee_soft`]), m (where the deleted knee ease once switched on).
 pub const KNEE_EASE_SOFT: f64 = 0.00033;
 
 /// How many landing times after the shortest valid one [`VirtualLeg::plan_heel_rocker`] also tries
@@ -142,18 +132,6 @@ pub struct VirtualLeg {
     /// rest, in slow walks (see [`VirtualLeg::plan_heel_rocker`]). The walk's steps do; the
     /// stop's landing does not (measured worse there: 3 km/h 2.9 → 4.0, 5 km/h 6.0 → 7.8).
     pub slow_knee_start: bool,
-    /// State of the knee's eased straightening (see [`KNEE_EASE`]): time, knee flexion and its
-    /// rate at the last flat / heel-off sample, and the rule's knee then. `None` before the
-    /// foot is flat (set at foot flat by a landing, see [`KNEE_LAND_EASE`] and
-    /// [`KNEE_ROCKER_EASE`]).
-    pub knee_ease: Option<[f64; 4]>,
-    /// Whether the straight leg landed the foot (no planned heel rocker): the knee then eases
-    /// from straight toward the flat and heel-off rules' knee from either side (see
-    /// [`KNEE_LAND_EASE`]), not only from the more flexed side.
-    pub ease_from_landing: bool,
-    /// Whether the knee ease after a planned heel rocker's landing started from the rocker's
-    /// knee and rate (see [`KNEE_EASE`]): it then eases toward the rule's knee from either side.
-    pub ease_from_rocker: bool,
     /// Longest hip–ankle span the flat and heel-off rules draw, m: `l3 + l4` (the paper's
     /// straight knee), shorter where the stance leg locked short of `l1` at speed
     /// (`StanceSpec::drawn_span`): the knee then keeps that flexion through midstance and heel
@@ -175,9 +153,6 @@ pub struct HeelRocker {
     pub end: f64,
     /// `(t, ρ)` samples up to `end`.
     pub table: Vec<(f64, f64)>,
-    /// The knee flexion at `end` (the flat foot's), rad, and its rate there, rad/s: the knee
-    /// ease after foot flat starts from them (see [`KNEE_EASE`]).
-    pub knee_end: [f64; 2],
 }
 
 impl HeelRocker {
@@ -279,9 +254,6 @@ impl VirtualLeg {
             rocker: None,
             knee_soft: KNEE_SOFT,
             slow_knee_start: true,
-            knee_ease: None,
-            ease_from_landing: false,
-            ease_from_rocker: false,
             span_max: body.l3 + body.l4,
             rocker_gap: None,
         }
@@ -546,16 +518,7 @@ impl VirtualLeg {
             if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
                 best_fast = f >= 2.0;
                 best_dips = knee_dips(k_end, big_t, r0, k_rate);
-                best = Some((
-                    cost,
-                    HeelRocker {
-                        end,
-                        table,
-                        knee_end: [k_end, k_rate],
-                    },
-                    landing,
-                    soft,
-                ));
+                best = Some((cost, HeelRocker { end, table }, landing, soft));
             }
             left = left.min(scan + 1) - 1;
         }
@@ -567,53 +530,6 @@ impl VirtualLeg {
         true
     }
 
-    /// The leg length of the knee eased toward the rule's (`d_rule`) at time `t`, never longer
-    /// than it (see [`KNEE_EASE`]): the exact critically damped step from the last sample's
-    /// knee and rate toward the rule's knee; where the rule's knee is the more flexed, the knee
-    /// takes it and its rate. After a straight-leg landing ([`KNEE_LAND_EASE`]) or a narrowed
-    /// rocker landing ([`KNEE_ROCKER_EASE`]) the knee eases from either side, longer or
-    /// shorter than the rule.
-    fn eased_span(&mut self, t: f64, d_rule: f64) -> f64 {
-        let (l3, l4) = (self.l3, self.l4);
-        let k_rule = knee_for(l3, l4, d_rule);
-        let (k, kd) = match self.knee_ease {
-            Some([t0, k0, kd0, kr0]) if t > t0 => {
-                let h = t - t0;
-                let w = if self.ease_from_landing {
-                    1.0 / KNEE_LAND_EASE
-                } else if self.ease_from_rocker {
-                    1.0 / KNEE_ROCKER_EASE
-                } else {
-                    1.0 / KNEE_EASE
-                };
-                let e = k0 - k_rule;
-                let c = kd0 + w * e;
-                let decay = (-w * h).exp();
-                let k1 = k_rule + (e + c * h) * decay;
-                let kd1 = (kd0 - w * c * h) * decay;
-                // A knee eased from a straightening landing never passes straight: it stops
-                // there (not reached in the measured walks, whose rule's knee re-targets it).
-                let (k1, kd1) = if k1 < 0.0 { (0.0, 0.0) } else { (k1, kd1) };
-                if k1 <= k_rule && !self.ease_from_landing && !self.ease_from_rocker {
-                    (k_rule, (k_rule - kr0) / h)
-                } else {
-                    (k1, kd1)
-                }
-            }
-            Some([_, k0, kd0, _]) if self.ease_from_landing || self.ease_from_rocker => (k0, kd0),
-            Some([_, k0, kd0, _]) => (k0.max(k_rule), kd0),
-            None => (k_rule, 0.0),
-        };
-        self.knee_ease = Some([t, k, kd, k_rule]);
-        if self.ease_from_landing || self.ease_from_rocker {
-            span_for(l3, l4, k)
-        } else if k > k_rule {
-            span_for(l3, l4, k).min(d_rule)
-        } else {
-            d_rule
-        }
-    }
-
     /// Advances the rules to time `t` (leg clock) with the hip at `hip` and lateral offset `dz`
     /// and returns the configuration. Calls must come in time order.
     pub fn advance(&mut self, t: f64, hip: [f64; 2], dz: f64) -> LegPose {
@@ -621,11 +537,7 @@ impl VirtualLeg {
         // How far `leg`'s ankle at roll `r` is beyond the straight leg's reach, m.
         let reach = |leg: &VirtualLeg, r: f64| leg.span_at(hip, dz, r) - l1;
         if self.period == FootPeriod::HeelRocker {
-            if let Some((end, rho, [k_end, k_rate])) = self
-                .rocker
-                .as_ref()
-                .map(|r| (r.end, r.rho_at(t), r.knee_end))
-            {
+            if let Some((end, rho)) = self.rocker.as_ref().map(|r| (r.end, r.rho_at(t))) {
                 if t < end {
                     self.rho = rho.max(self.rho);
                     return self.pose_at(hip, dz, self.rho);
@@ -633,12 +545,6 @@ impl VirtualLeg {
                 self.period = FootPeriod::Flat;
                 self.rho = 0.0;
                 self.transitions[0] = Some(end);
-                // A landing that narrowed the knee's soft margin (slow walks): the knee eases
-                // on from the rocker's knee and rate (see `KNEE_ROCKER_EASE`).
-                if self.knee_soft < KNEE_SOFT {
-                    self.knee_ease = Some([end, k_end, k_rate, k_end]);
-                    self.ease_from_rocker = true;
-                }
             }
         }
         if self.period == FootPeriod::HeelRocker {
@@ -660,11 +566,7 @@ impl VirtualLeg {
                 self.rho = 0.0;
                 self.transitions[0] = Some(t);
                 // The straight leg lands the foot (no planned rocker: slow walks, whose hip
-                // never comes within the straight leg's reach of the flat ankle) with the knee
-                // straight and at rest; the flat and heel-off rules' knee is eased up from there
-                // (see `KNEE_LAND_EASE`), not taken in this frame.
-                self.knee_ease = Some([t, 0.0, 0.0, 0.0]);
-                self.ease_from_landing = true;
+                // never comes within the straight leg's reach of the flat ankle).
             } else {
                 let a = -1.2;
                 // Out of reach even steeply pitched: hold the roll (pitching the foot up to
@@ -692,23 +594,6 @@ impl VirtualLeg {
             let sigma = self.knee_soft;
             let lm = self.span_max.min(l1);
             let d_t = crate::generator::ik::soft_reach(d_flat, lm, sigma);
-            // Only where a landing narrowed the knee's soft margin (see `KNEE_EASE_SOFT`,
-            // `KNEE_ROCKER_EASE`) or the straight leg landed the foot (`KNEE_LAND_EASE`).
-            let d_t = if self.knee_soft < KNEE_EASE_SOFT
-                || self.ease_from_landing
-                || self.ease_from_rocker
-            {
-                let eased = self.eased_span(t, d_t);
-                // While the foot is flat the eased knee is never more flexed than the flat
-                // foot's own (the span never shorter than the rule's), see `KNEE_ROCKER_EASE`.
-                if self.period == FootPeriod::Flat {
-                    eased.max(d_t)
-                } else {
-                    eased
-                }
-            } else {
-                d_t
-            };
             // `reach(r) + l1`, not the span itself: the same rounding as before the scans
             // stopped evaluating the whole pose.
             let g = |r: f64| reach(self, r) + l1 - d_t;
@@ -990,44 +875,5 @@ mod tests {
             );
             assert!(start_rate.abs() < 0.05, "{start_rate}");
         }
-    }
-
-    #[test]
-    fn eased_knee_peaks_and_settles_c1_and_never_straighter_than_the_rule() {
-        // The rule's knee as at 1 km/h heel off: flexing at 1.5 rad/s up to a sharp peak at
-        // 0.1 s, straightening at 1.2 rad/s, then at rest at 0.02 rad (kinks at both ends).
-        let body = Body::from_height(1.8, 75.0).unwrap();
-        let mut leg = test_leg(&body, FootPeriod::Flat, 0.0);
-        let (l3, l4) = (leg.l3, leg.l4);
-        let rule = |t: f64| {
-            if t <= 0.1 {
-                0.02 + 1.5 * t
-            } else {
-                (0.17 - 1.2 * (t - 0.1)).max(0.02)
-            }
-        };
-        let h = 0.002;
-        let mut knees = Vec::new();
-        for i in 0..=200 {
-            let t = h * i as f64;
-            let d_rule = span_for(l3, l4, rule(t));
-            let d = leg.eased_span(t, d_rule);
-            assert!(d <= d_rule + 1e-12, "longer than the rule at {t}");
-            knees.push(knee_for(l3, l4, d));
-        }
-        let rates: Vec<f64> = knees.windows(2).map(|w| (w[1] - w[0]) / h).collect();
-        let worst_change = rates
-            .windows(2)
-            .map(|w| (w[1] - w[0]).abs())
-            .fold(0.0, f64::max);
-        // The rule's rate changes by 2.7 rad/s within one sample at the peak; the eased knee's
-        // by at most h/τ of it per sample (C¹, second-order lag).
-        assert!(worst_change < 0.6, "rate change per sample {worst_change}");
-        // It peaks after the rule (flexing on briefly) and settles on the rule at rest.
-        let peak = (0..knees.len())
-            .max_by(|&a, &b| knees[a].total_cmp(&knees[b]))
-            .unwrap_or(0);
-        assert!(peak as f64 * h > 0.1 && knees[peak] > 0.17);
-        assert!((knees[200] - 0.02).abs() < 1e-3, "{}", knees[200]);
     }
 }
