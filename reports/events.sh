@@ -41,9 +41,12 @@ events build them) is in the `data/*.csv` tables.
     plates with ezc3d's own force-platform extraction (not gaitfit's C3D reader), 20 N on the
     unfiltered vertical force, feet by the heel–toe midpoint nearest the centre of pressure
     (`tools/events/schreiber_force_events.csv`, 48 events). gaitfit's plate events match every
-    one, worst |Δ| 0.005 ms, same feet (`cargo test --release --test events_force_timing --
-    --include-ignored --nocapture`); the walking scores below and gaitkit's are now against
-    that file (figures unchanged).
+    one, worst |Δ| 0.005 ms, same feet; likewise for the BMClab walks, read from the Cortex
+    `.forces` table by the same script (`tools/events/bmclab_walk_force_events.csv`, 13 events,
+    worst |Δ| 0.005 ms) (`cargo test --release --test events_force_timing --
+    --include-ignored --nocapture`). The walking marker scores of
+    `tests/events_walk_kinematic.rs` and gaitkit's Schreiber scores are against these files
+    (figures unchanged).
   - *BMClab heel strike −16.6 ms: the walking speed, not the lab.* With Bonci's fixed 0.5 ×
     walking speed, heel strike − plate is −18.0 ± 11.0 ms on Schreiber's self-selected walks
     (C4, 1.11 m/s, n 11), −7.9 ± 7.4 ms on its fast walks (C5, 1.57 m/s, n 12) and

@@ -258,3 +258,35 @@ fn schreiber_plate_events_match_20_n_on_ezc3d_plates() {
         worst * 1e3
     );
 }
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn bmclab_walk_plate_events_match_20_n_on_the_forces_export() {
+    // The reference reads the Cortex `.forces` table itself (7 plates, FYk vertical) and
+    // assigns the feet by the TRC's heel–MT2 midpoint nearest the centre of pressure.
+    let root = require("bmclab");
+    let events = tool_csv("bmclab_walk_force_events.csv");
+    let (mut worst, mut n) = (0.0f64, 0usize);
+    for trial in ["walk1", "walk2"] {
+        let t = read_trial(&root.join(format!("{trial}.trc")), &ReadOptions::default()).unwrap();
+        let an = analyse(&t, &EventOptions::default()).unwrap();
+        let reference: Vec<(Side, EventKind, f64)> = events
+            .iter()
+            .filter(|r| r[0] == trial)
+            .map(|r| {
+                (
+                    Side::parse(&r[1]).unwrap(),
+                    kind(&r[2]),
+                    r[3].parse().unwrap(),
+                )
+            })
+            .collect();
+        worst = worst.max(check_events(trial, &an.events.force, &reference));
+        n += reference.len();
+    }
+    assert_eq!(n, 13);
+    println!(
+        "BMClab walks: {n} plate events, worst |gaitfit − numpy| {:.3} ms",
+        worst * 1e3
+    );
+}

@@ -3,8 +3,8 @@
 //! plate event inside the marker record scored. Schreiber's plate events are read from
 //! `tools/events/schreiber_force_events.csv` (tools/events/force_truth.py: ezc3d's plate
 //! extraction and numpy, no gaitfit; gaitfit's own plate events agree within 0.01 ms,
-//! tests/events_force_timing.rs); the BMClab walks' are gaitfit's (the `.forces` export has no
-//! independent reader here). Each Schreiber & Moissenet (2019) record starts about 0.05 s before a
+//! tests/events_force_timing.rs); the BMClab walks' from `bmclab_walk_force_events.csv` (the
+//! same script reading the Cortex `.forces` table; gaitfit within 0.01 ms). Each Schreiber & Moissenet (2019) record starts about 0.05 s before a
 //! plate heel strike, which the Zeni seeds cannot see.
 //!
 //! Sets: Schreiber subjects 2014001/2014004/2014007 ("train": where the alternative heel-strike
@@ -40,24 +40,29 @@ fn schreiber(subjects: &[&str]) -> Vec<PathBuf> {
     files
 }
 
-/// The script's plate events of a Schreiber trial (file stem), or `None` for another data set.
-fn script_plates(path: &std::path::Path) -> Option<Vec<GaitEvent>> {
-    if path.extension().is_none_or(|e| e != "c3d") {
-        return None;
-    }
-    let trial = path.file_stem()?.to_str()?;
+/// The script's plate events of a trial (file stem): Schreiber's C3Ds and the BMClab walks
+/// (tools/events/force_truth.py, no gaitfit).
+fn script_plates(path: &std::path::Path) -> Vec<GaitEvent> {
+    let trial = path.file_stem().unwrap().to_str().unwrap();
+    // (file, columns before `side`: subject and trial, or trial alone)
+    let (name, skip) = if path.extension().is_some_and(|e| e == "c3d") {
+        ("schreiber_force_events.csv", 1)
+    } else {
+        ("bmclab_walk_force_events.csv", 0)
+    };
     let csv = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tools/events/schreiber_force_events.csv");
+        .join("tools/events")
+        .join(name);
     let text = std::fs::read_to_string(csv).unwrap();
     let ev: Vec<GaitEvent> = text
         .lines()
         .skip(1)
-        .map(|l| l.split(',').collect::<Vec<_>>())
-        .filter(|r| r[1] == trial)
+        .map(|l| l.split(',').skip(skip).collect::<Vec<_>>())
+        .filter(|r| r[0] == trial)
         .map(|r| GaitEvent {
-            time_s: r[4].parse().unwrap(),
-            side: Side::parse(r[2]).unwrap(),
-            kind: match r[3] {
+            time_s: r[3].parse().unwrap(),
+            side: Side::parse(r[1]).unwrap(),
+            kind: match r[2] {
                 "heel_strike" => EventKind::HeelStrike,
                 "toe_off" => EventKind::ToeOff,
                 other => panic!("unknown event {other}"),
@@ -65,8 +70,8 @@ fn script_plates(path: &std::path::Path) -> Option<Vec<GaitEvent>> {
             source: EventSource::Force,
         })
         .collect();
-    assert!(!ev.is_empty(), "{trial}: not in schreiber_force_events.csv");
-    Some(ev)
+    assert!(!ev.is_empty(), "{trial}: not in {name}");
+    ev
 }
 
 /// Scores every file of a set; returns the counts per event kind and the number of plate
@@ -85,7 +90,7 @@ fn score(files: &[PathBuf], hs_fraction: f64) -> (BTreeMap<EventKind, KindCounts
         assert_eq!(an.events.primary, EventSource::FootSpeed, "{}", f.display());
         let k = an.kinematics.as_ref().unwrap();
         let span = (k.time_s[0], k.time_s[k.time_s.len() - 1]);
-        let plates = script_plates(f).unwrap_or_else(|| an.events.force.clone());
+        let plates = script_plates(f);
         at_start += plates.iter().filter(|e| e.time_s < span.0 + 0.1).count();
         let res = compare(
             an.events.primary_events(),

@@ -23,6 +23,12 @@ guide's force-plate truth (20 N on the unfiltered vertical force) and gaitfit's 
   contact goes to the foot whose heel–second-metatarsal midpoint (markers `*_FCC`, `*_FM2`),
   averaged over the loaded marker frames, lies nearest the mean centre of pressure. Times from
   the first sample (analog sample k at k/1500 s, marker frame i at i/100 s).
+- BMClab overground walks `walk1`/`walk2` (Cortex export): `.forces`, 7 plates at 450 Hz, the
+  vertical force is `FYk` (Y up), the centre of pressure (`Xk`, `Zk`, mm); the export zeroes
+  the force below ≈ 30 N (first nonzero sample at contact 37–53 N), so the 20 N crossing is
+  interpolated from the zeroed sample, within one 2.2 ms sample of the true one. Feet as for
+  Schreiber, with the TRC's `R.Heel`/`R.MT2` and `L.Heel`/`L.MT2` (150 Hz). Sample k (the
+  `#Sample` column minus 1) at k/450 s, TRC frame i at its Time column.
 
 Double support (the walking paper's t_ds, one period) for WBDS: from each heel strike to the
 other foot's next toe off, when no toe off of the same foot comes first. The variant
@@ -49,7 +55,7 @@ zero shortens the mean double support by 8–16 ms (T08–T05). The truth stays 
 Run from the repository root (shared data in ../shared/data or $GAITFIT_SHARED_DATA):
     /work/venv/bin/python tools/events/force_truth.py
 It writes, beside this script, wbds04_force_events.csv, wbds04_force_events_bridged.csv and
-hamner_force_events.csv and schreiber_force_events.csv (every event) and wbds04_double_support.csv
+hamner_force_events.csv, schreiber_force_events.csv and bmclab_walk_force_events.csv (every event) and wbds04_double_support.csv
 (per trial); tests/events_force_timing.rs compares gaitfit's force events with them and
 tests/events_walk_kinematic.rs scores the walking marker events against the Schreiber ones.
 """
@@ -251,6 +257,51 @@ def schreiber(root):
     write("schreiber_force_events.csv", ["subject", "trial", "side", "event", "time_s"], rows)
 
 
+def read_trc(path):
+    """Time (s) and markers (name → n × 3 array, file units) of a TRC file."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    names = lines[3].split("\t")
+    rows = [line.split("\t") for line in lines[5:] if line.strip()]
+    t = np.array([float(r[1]) for r in rows])
+    out = {}
+    for i, name in enumerate(names):
+        if i >= 2 and name.strip():
+            out[name.strip()] = np.array(
+                [[float(r[i + k]) if i + k < len(r) and r[i + k].strip() else np.nan
+                  for k in range(3)] for r in rows])
+    return t, out
+
+
+def bmclab(root):
+    rows = []
+    for trial in ("walk1", "walk2"):
+        base = os.path.join(root, "bmclab", trial)
+        with open(base + ".forces") as f:
+            head = [next(f) for _ in range(4)]
+        rate = float(next(x for x in head if x.startswith("SampleRate=")).split("=")[1])
+        data = np.genfromtxt(base + ".forces", delimiter="\t", names=True, skip_header=4,
+                             deletechars="")
+        tm, markers = read_trc(base + ".trc")
+        foot = {side: 0.5 * (markers[f"{p}.Heel"] + markers[f"{p}.MT2"])
+                for side, p in (("left", "L"), ("right", "R"))}
+        t = np.arange(len(data)) / rate
+        for k in range(1, 8):
+            fy = data[f"FY{k}"]
+            loaded = fy > CONFIRM_N
+            if not loaded.any():
+                continue
+            hs, to = events(t, fy)
+            cop = np.array([np.mean(data[f"X{k}"][loaded]), np.mean(data[f"Z{k}"][loaded])])
+            frames = np.unique(np.clip(np.searchsorted(tm, t[loaded]), 0, len(tm) - 1))
+            dist = {side: np.linalg.norm(np.nanmean(m[frames][:, [0, 2]], axis=0) - cop)
+                    for side, m in foot.items()}
+            side = min(dist, key=dist.get)
+            rows += [(trial, side, "heel_strike", f"{x:.5f}") for x in hs]
+            rows += [(trial, side, "toe_off", f"{x:.5f}") for x in to]
+    write("bmclab_walk_force_events.csv", ["trial", "side", "event", "time_s"], rows)
+
+
 def write(name, header, rows):
     out = os.path.join(HERE, name)
     with open(out, "w", newline="") as f:
@@ -265,3 +316,4 @@ if __name__ == "__main__":
     wbds(r)
     hamner(r)
     schreiber(r)
+    bmclab(r)
