@@ -2,7 +2,7 @@
 //! angles — measured here from the skeleton's joint centres and foot points — are the angles the
 //! comparison scores for the carried variant ([`carried_angles`]), and the feet are the paper's,
 //! so the stance foot does not slide or sink (the shared generator checks). Property-tested over
-//! random heights, step lengths and residual curves on the bundled (Winter) prototype, and on the
+//! random heights, step lengths and perturbed carried curves on the bundled (Winter) prototype, and on the
 //! prototype's own measured curves.
 use gaitfit::events::Side;
 use gaitfit::generator::checks::{ground_penetration, stance_sliding};
@@ -143,12 +143,12 @@ fn check(p: &Prototype, c: &Carried, height: f64, lengths: &[f64]) -> f64 {
 }
 
 #[test]
-fn random_residuals_are_drawn_as_compared_and_the_feet_stay_the_papers() {
+fn perturbed_curves_are_drawn_as_compared_and_the_feet_stay_the_papers() {
     let p = Prototype::bundled();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
     let mut moved: f64 = 0.0;
     for case in 0..6 {
-        // Smooth residuals up to ~8°: a few harmonics over the stride.
+        // Smooth perturbations up to ~8°: a few harmonics over the stride.
         let mut curve = |amp: f64| -> Vec<f64> {
             let (a1, a2, ph1, ph2) = (
                 rng.random_range(-amp..amp),
@@ -163,7 +163,15 @@ fn random_residuals_are_drawn_as_compared_and_the_feet_stay_the_papers() {
                 })
                 .collect()
         };
-        let c = Carried::from_residual(curve(0.07), curve(0.14), curve(0.1)).unwrap();
+        // Winter's measured curves, perturbed.
+        let own = p.angles.as_ref().unwrap();
+        let add = |a: &[f64], d: Vec<f64>| a.iter().zip(d).map(|(x, y)| x + y).collect::<Vec<_>>();
+        let c = Carried::from_curves(
+            add(&own.hip, curve(0.07)),
+            add(&own.knee, curve(0.14)),
+            add(&own.ankle, curve(0.1)),
+        )
+        .unwrap();
         let height = rng.random_range(1.55..1.95);
         let base = p.walk.step_length() * height / 1.75;
         let lengths: Vec<f64> = (0..4)
@@ -180,7 +188,7 @@ fn random_residuals_are_drawn_as_compared_and_the_feet_stay_the_papers() {
 fn the_bundled_prototypes_own_curves_are_drawn_as_compared() {
     let p = Prototype::bundled();
     let c = p
-        .carried(default_alpha())
+        .carried()
         .unwrap()
         .expect("the bundled prototype carries its angles");
     check(&p, &c, 1.8, &[0.75, 0.8, 0.7, 0.78]);

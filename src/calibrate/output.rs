@@ -502,8 +502,7 @@ fn kb_loo_html(l: &super::kb::KbLeaveOneOut) -> String {
          per target then over targets ({} pair(s) left out: a μ out of its range). <i>Paper</i>: \
          the angles of W's rigid two-link drawing. <i>Carried</i>: the source's measured angle \
          curves kept in W — the generalized step drawn with the paper's feet and the hip placed \
-         where the drawn angles come nearest its rendering plus the source's measured-minus-\
-         rendered residual (what `gaitfit generate generalize --kb-variant carried` draws); the \
+         where the drawn angles come nearest the source's measured curves (what `gaitfit generate generalize --kb-variant carried` draws); the \
          ankle path is the paper's. <i>Naive scaling</i>: the source's measured stride unchanged on normalized \
          time, its ankle path scaled by the leg-length ratio.</p><table><tr><th>candidate</th>\
          <th>hip (deg)</th><th>knee (deg)</th><th>ankle (deg)</th><th>swing ankle path (cm)</th>\

@@ -75,8 +75,8 @@ pub struct Options {
     pub step_freq: Option<f64>,
     /// Ko–Badler variant: `paper` (W's rigid drawing, eqs. 11–12, 25–48) or `carried` (the
     /// prototype's measured angle curves kept in W: the paper's feet, the hip placed where the
-    /// drawn angles come nearest the generalized step's rendering plus the prototype's residual;
-    /// the prototype must carry measured angles — the bundled one does).
+    /// drawn angles come nearest them; the prototype must carry measured angles — the bundled
+    /// one does).
     #[arg(
         long = "kb-variant",
         value_name = "paper|carried",
@@ -287,7 +287,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     let plan = plan_steps(c, args.step_length, default_duration)?;
     let carried = match args.kb_variant {
         Variant::Paper => None,
-        Variant::Carried => Some(proto.carried(alpha)?.ok_or_else(|| {
+        Variant::Carried => Some(proto.carried()?.ok_or_else(|| {
             anyhow!(
                 "--kb-variant carried: the prototype ({source}) carries no measured angle curves \
                  (a prototype built by --build-prototype, or the bundled one, has them)"

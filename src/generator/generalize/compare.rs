@@ -11,9 +11,9 @@
 //!   B's body and φ onto B's step length (after a step of the same length), rendered;
 //! - **generalized, carried** ([`Variant::Carried`], [`super::carried`]): the same step, with
 //!   A's own character carried in W — A's measured angle curves are kept with W, and the step is
-//!   drawn with the paper's feet and the hip placed where the drawn angles come nearest the
-//!   generalized step's rendering plus A's residual (measured − A's own rendered step, on the
-//!   same normalized step time: φ and ψ keep the moments). These are the angles
+//!   drawn with the paper's feet and the hip placed where the drawn angles come nearest A's
+//!   measured curves (on the same normalized step time: φ and ψ keep the moments). These are
+//!   the angles
 //!   `gaitfit generate generalize --kb-variant carried` draws; the ankle path is the paper's;
 //! - **naive**: A's measured stride unchanged in angles and time-normalized, its ankle path
 //!   scaled by ll(B)/ll(A) (A's step scaled uniformly in size and time);
@@ -37,14 +37,16 @@
 //! with step length (≈ 3.5 / 4.5 / 4° between the two speeds), less than φ changes them.
 //!
 //! The carried variant (issue 21 item 5, `tests/kb_carried.rs`, lateral markers, 2026-12-07):
-//! hip / knee / ankle RMS 6.2 / 10.2 / 6.8° against the paper's 9.0 / 16.1 / 8.1° and naive
-//! scaling's 5.3 / 7.7 / 5.7°; ankle path 6.4 cm (the paper's) against naive's 9.0 cm. Carrying
-//! the residual removes the model floor, so what is left is what φ and ψ change in the drawn
-//! angles: within one subject between its two speeds they change the stance knee by 7.6° RMS
-//! while the subject's knee changes by 4.5° — eq. 27's linear pinning of the hip heights lowers
-//! the mid-stance hip for longer steps. Other carried designs measured, none better: the
-//! residual simply added to the rendered angles (not drawable — the feet would move; 6.1 / 10.6
-//! / 6.5°), the stance knee's rendered curve as the IK's preferred posture (the hip height that
+//! hip / knee / ankle RMS 4.8 / 7.7 / 6.7° against the paper's 9.0 / 16.1 / 8.1° and naive
+//! scaling's 5.3 / 7.7 / 5.7°; ankle path 6.4 cm (the paper's) against naive's 9.0 cm: hip
+//! better than naive, knee equal, ankle 1.0° worse (the drawn ankle angle is the paper's foot
+//! angle, set by F₁/F₂/F₃ and μ, less the shank's). Earlier carried designs, all worse: the
+//! generalized step's rendering plus the prototype's measured-minus-rendered residual as the
+//! preferred posture (6.2 / 10.2 / 6.8°) or simply added to the rendered angles (not drawable —
+//! the feet would move; 6.1 / 10.6 / 6.5°) — both carry what φ changes in the rendered angles:
+//! within one subject between its two speeds φ changes the stance knee by 7.6° RMS while the
+//! subject's knee changes by 4.5° (eq. 27's linear pinning of the hip heights lowers the
+//! mid-stance hip for longer steps); the stance knee's rendered curve as the IK's preferred posture (the hip height that
 //! gives it, pinned at the ends as eq. 27; 6.5 / 10.6 / 6.3°), and the swing ankle path kept
 //! relative to the hip (6.1 / 10.8 / 6.5°).
 use super::angles::{model_angles, Angles};
@@ -468,7 +470,7 @@ pub fn generalize_onto_with(
     match variant {
         Variant::Paper => render(&g, &w),
         Variant::Carried => {
-            let c = Carried::from_measured(&src.angles, &src.prototype.walk, &mu)?;
+            let c = Carried::from_measured(&src.angles)?;
             carried_angles(&w, &mu, &c)
         }
     }

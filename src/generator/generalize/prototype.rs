@@ -613,17 +613,10 @@ impl Prototype {
         )
     }
 
-    /// The residual the carried variant keeps: the measured angles minus W rendered with the
-    /// μ-functions of slopes `alpha` ([`Carried::from_measured`]); `None` without measured angles.
-    pub fn carried(&self, alpha: [f64; 4]) -> Result<Option<Carried>, GenerateError> {
-        match &self.angles {
-            Some(a) => Ok(Some(Carried::from_measured(
-                a,
-                &self.walk,
-                &self.mu(alpha)?,
-            )?)),
-            None => Ok(None),
-        }
+    /// The curves the carried variant keeps ([`Carried::from_measured`]); `None` without
+    /// measured angles.
+    pub fn carried(&self) -> Result<Option<Carried>, GenerateError> {
+        self.angles.as_ref().map(Carried::from_measured).transpose()
     }
 
     /// The prototype bundled with gaitfit: Winter's walk (`data/prototype_winter.json`).
