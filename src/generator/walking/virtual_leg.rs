@@ -31,20 +31,11 @@ use std::f64::consts::FRAC_PI_2;
 /// Width of the knee's soft straightening in late stance, m.
 pub const KNEE_SOFT: f64 = 0.0015;
 
-/// [`VirtualLeg::plan_heel_rocker`] compares a landing only with landings on the same side of
-/// this soft margin ([`VirtualLeg::knee_soft`]), m (where the deleted knee ease once switched on).
-pub const KNEE_EASE_SOFT: f64 = 0.00033;
-
 /// How many landing times after the shortest valid one [`VirtualLeg::plan_heel_rocker`] also tries
 /// (on its ×1.1 grid: up to ≈ 1.5 × the shortest), keeping the one whose knee Hermite has the least
 /// peak acceleration `max(|k̈(0)|, |k̈(T)|)` (a cubic's second derivative is linear, so its peak is
 /// at an end).
 pub const ROCKER_SCAN: usize = 4;
-
-/// How much gentler (peak knee acceleration, [`ROCKER_SCAN`]'s cost) a landing must be to replace a
-/// kept landing whose knee dips (flexes, straightens and flexes again) against the knee-ease rule
-/// there.
-pub const DIP_TRADE: f64 = 3.0;
 
 /// Knee flexion rate at toe-off, rad/s (at most; less when the meta-off knee flexion is slow).
 pub const TOE_OFF_KNEE_RATE: f64 = 8.0;
@@ -179,22 +170,6 @@ impl HeelRocker {
 /// Knee flexion of a two-link leg (`l3`, `l4`) spanning `d`, rad.
 fn knee_for(l3: f64, l4: f64, d: f64) -> f64 {
     crate::generator::ik::flexion_for_span(l3, l4, d)
-}
-
-/// Whether the heel rocker's knee Hermite (from straight at rate `r0` to `k_end` at rate `r1`
-/// over `big_t`) flexes, straightens and flexes again: its rate, a quadratic in time, turns
-/// negative inside the rocker and is positive at its end.
-fn knee_dips(k_end: f64, big_t: f64, r0: f64, r1: f64) -> bool {
-    // The rate in u = t/T: a·u² + b·u + c.
-    let m = k_end / big_t;
-    let a = -6.0 * m + 3.0 * (r0 + r1);
-    let b = 6.0 * m - 4.0 * r0 - 2.0 * r1;
-    let c = r0;
-    if r1 <= 0.0 || a <= 0.0 {
-        return false;
-    }
-    let u = -b / (2.0 * a);
-    u > 0.0 && u < 1.0 && c - b * b / (4.0 * a) < 0.0
 }
 
 /// Length of a two-link leg with knee flexion `knee`, m.
@@ -410,8 +385,6 @@ impl VirtualLeg {
         let mut duration = min_duration;
         let mut best: Option<(f64, HeelRocker, f64, f64)> = None;
         let mut left = usize::MAX;
-        let mut best_fast = false;
-        let mut best_dips = false;
         for _ in 0..30 {
             let kt = samples.partition_point(|s| s.0 < t_first + duration);
             if left == 0 || kt + 1 >= samples.len() {
@@ -497,27 +470,7 @@ impl VirtualLeg {
             let acc0 = (6.0 * k_end - big_t * (4.0 * r0 + 2.0 * k_rate)) / (big_t * big_t);
             let acc1 = (-6.0 * k_end + big_t * (2.0 * r0 + 4.0 * k_rate)) / (big_t * big_t);
             let cost = acc0.abs().max(acc1.abs());
-            // Never a landing that turns the knee ease on or off against the shortest's.
-            let eased = soft.max(0.5 * (l1 - landing)) < KNEE_EASE_SOFT;
-            let same = best
-                .as_ref()
-                .is_none_or(|b| (b.3.max(0.5 * (l1 - b.2)) < KNEE_EASE_SOFT) == eased);
-            // Unless the kept landing's knee leaves heel strike at twice its mean rate or faster
-            // (a knee at rest in swing then flexes ≈ 0.03 rad in the first frame: 1 → 7 km/h ×
-            // 2.0 m's 4 km/h step, whose shortest landing is eased and the gentler later ones not;
-            // ratio 26.85 → 4.58 without the rule there), or its knee flexes, straightens and
-            // flexes again (`knee_dips`: the first slower stance of a slow-down, which lands from
-            // the faster step's steeper heel-strike pitch; its shortest, eased landing must meet
-            // the flat foot's knee at 5 × its mean rate, 5–9 rad/s, and the knee flexed 0.012 rad
-            // in the first frame, straightened and surged 0.2 rad at foot flat: 3 → 1 km/h ×
-            // 1.8 m 10.6, 2 → 1 km/h × 1.8 m 7.9, 1.5 → 1 km/h × 2.0 m 6.2 → 4.2, 4.0, 4.8) and
-            // the new landing is at least `DIP_TRADE` × gentler.
-            let fast = best
-                .as_ref()
-                .is_some_and(|b| best_fast || (best_dips && cost * DIP_TRADE <= b.0));
-            if (same || fast) && best.as_ref().is_none_or(|b| cost < b.0) {
-                best_fast = f >= 2.0;
-                best_dips = knee_dips(k_end, big_t, r0, k_rate);
+            if best.as_ref().is_none_or(|b| cost < b.0) {
                 best = Some((cost, HeelRocker { end, table }, landing, soft));
             }
             left = left.min(scan + 1) - 1;
@@ -712,33 +665,6 @@ mod tests {
             .map(|w| ((w[2] - 2.0 * w[1] + w[0]) / 0.002f64.powi(2)).abs())
             .fold(0.0, f64::max);
         (peak, end)
-    }
-
-    #[test]
-    fn a_knee_hermite_dips_only_when_its_rate_turns_negative_inside() {
-        // The 3 -> 1 km/h x 1.8 m slow-down's first 1 km/h landing (T 58 ms, leaving at 1.5 x
-        // and meeting the flat knee at 5.3 x the mean rate): it flexes, straightens, flexes.
-        let (k, t) = (0.0965, 0.058);
-        assert!(knee_dips(k, t, 1.5 * k / t, 8.885));
-        // A steady 1 km/h x 1.5 m landing (from 0.25 x, meeting it at 3.3 x): monotone.
-        let (k, t) = (0.091, 0.0699);
-        assert!(!knee_dips(k, t, 0.25 * k / t, 4.358));
-        // A knee straightening at the landing is not a dip, nor a plain smoothstep.
-        assert!(!knee_dips(0.073, 0.11, 0.073 / 0.11, -1.4));
-        assert!(!knee_dips(0.1, 0.1, 0.0, 0.0));
-        // Check against the sampled rate.
-        for (r0, r1) in [(0.0, 2.9), (0.0, 3.1), (1.0, 4.0), (0.5, 4.3), (2.0, 6.0)] {
-            let (k, t) = (0.1, 0.1);
-            let m = k / t;
-            let sampled = (1..1000).any(|i| {
-                let u = i as f64 / 1000.0;
-                k * (6.0 * u - 6.0 * u * u) / t
-                    + r0 * m * ((3.0 * u - 4.0) * u + 1.0)
-                    + r1 * m * (3.0 * u - 2.0) * u
-                    < 0.0
-            });
-            assert_eq!(knee_dips(k, t, r0 * m, r1 * m), sampled, "{r0} {r1}");
-        }
     }
 
     #[test]
