@@ -41,6 +41,38 @@ fn kind(s: &str) -> EventKind {
     }
 }
 
+/// The `(subject, trial)` pairs of a reference table whose first two columns name them, in
+/// file order; the table must hold `n` trials.
+fn subject_trials(events: &[Vec<String>], n: usize) -> Vec<(String, String)> {
+    let mut trials: Vec<(String, String)> = events
+        .iter()
+        .map(|r| (r[0].clone(), r[1].clone()))
+        .collect();
+    trials.dedup();
+    assert_eq!(trials.len(), n);
+    trials
+}
+
+/// The reference events `(side, kind, time)` of the rows `keep` selects; `at` is the column of
+/// the side (kind and time follow it).
+fn reference_rows(
+    events: &[Vec<String>],
+    at: usize,
+    keep: impl Fn(&[String]) -> bool,
+) -> Vec<(Side, EventKind, f64)> {
+    events
+        .iter()
+        .filter(|r| keep(r))
+        .map(|r| {
+            (
+                Side::parse(&r[at]).unwrap(),
+                kind(&r[at + 1]),
+                r[at + 2].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
 /// Every reference `(side, kind, time)` has a gaitfit event of that foot and kind within
 /// [`EVENT_TOL_S`]; returns the largest error, s.
 fn check_events(label: &str, found: &[GaitEvent], reference: &[(Side, EventKind, f64)]) -> f64 {
@@ -92,17 +124,7 @@ fn wbds04_reading(bridge: bool, events_csv: &str, ds_col: usize) -> Vec<(String,
         let mut opts = EventOptions::default();
         opts.force.bridge_dropouts = bridge;
         let an = analyse(&t, &opts).unwrap();
-        let reference: Vec<(Side, EventKind, f64)> = events
-            .iter()
-            .filter(|r| &r[0] == trial)
-            .map(|r| {
-                (
-                    Side::parse(&r[1]).unwrap(),
-                    kind(&r[2]),
-                    r[3].parse().unwrap(),
-                )
-            })
-            .collect();
+        let reference = reference_rows(&events, 1, |r| &r[0] == trial);
         let worst = check_events(trial, &an.events.force, &reference);
         let steps = steps_from_analysis(&t, &an, &opts).unwrap();
         let d: Vec<f64> = steps
@@ -159,12 +181,7 @@ fn wbds04_bridged_dropouts_match_the_bridged_reference() {
 fn hamner_events_match_20_n_on_the_unfiltered_force() {
     let root = require("hamner2013");
     let events = tool_csv("hamner_force_events.csv");
-    let mut trials: Vec<(String, String)> = events
-        .iter()
-        .map(|r| (r[0].clone(), r[1].clone()))
-        .collect();
-    trials.dedup();
-    assert_eq!(trials.len(), 20);
+    let trials = subject_trials(&events, 20);
     let (mut worst, mut n, mut skipped) = (0.0f64, 0usize, 0usize);
     for (subject, trial) in &trials {
         let path = root.join(subject).join(format!("{trial}_grf.mot"));
@@ -186,18 +203,11 @@ fn hamner_events_match_20_n_on_the_unfiltered_force() {
         let kept = |t: f64| {
             !across.iter().any(|&(a, b)| t >= a && t <= b) && t > t0 + 0.05 && t < t1 - 0.05
         };
-        let reference: Vec<(Side, EventKind, f64)> = events
-            .iter()
-            .filter(|r| &r[0] == subject && &r[1] == trial)
-            .map(|r| {
-                (
-                    Side::parse(&r[2]).unwrap(),
-                    kind(&r[3]),
-                    r[4].parse().unwrap(),
-                )
-            })
-            .filter(|r| kept(r.2))
-            .collect();
+        let reference: Vec<(Side, EventKind, f64)> =
+            reference_rows(&events, 2, |r| &r[0] == subject && &r[1] == trial)
+                .into_iter()
+                .filter(|r| kept(r.2))
+                .collect();
         let found: Vec<GaitEvent> = an
             .events
             .force
@@ -225,12 +235,7 @@ fn schreiber_plate_events_match_20_n_on_ezc3d_plates() {
     // midpoint is nearest the centre of pressure; every event of both plates must match.
     let root = require("schreiber2019");
     let events = tool_csv("schreiber_force_events.csv");
-    let mut trials: Vec<(String, String)> = events
-        .iter()
-        .map(|r| (r[0].clone(), r[1].clone()))
-        .collect();
-    trials.dedup();
-    assert_eq!(trials.len(), 12);
+    let trials = subject_trials(&events, 12);
     let (mut worst, mut n) = (0.0f64, 0usize);
     for (subject, trial) in &trials {
         let path = root
@@ -239,17 +244,7 @@ fn schreiber_plate_events_match_20_n_on_ezc3d_plates() {
             .join(format!("{trial}.c3d"));
         let t = read_trial(&path, &ReadOptions::default()).unwrap();
         let an = analyse(&t, &EventOptions::default()).unwrap();
-        let reference: Vec<(Side, EventKind, f64)> = events
-            .iter()
-            .filter(|r| &r[0] == subject && &r[1] == trial)
-            .map(|r| {
-                (
-                    Side::parse(&r[2]).unwrap(),
-                    kind(&r[3]),
-                    r[4].parse().unwrap(),
-                )
-            })
-            .collect();
+        let reference = reference_rows(&events, 2, |r| &r[0] == subject && &r[1] == trial);
         worst = worst.max(check_events(trial, &an.events.force, &reference));
         n += reference.len();
     }
@@ -270,17 +265,7 @@ fn bmclab_walk_plate_events_match_20_n_on_the_forces_export() {
     for trial in ["walk1", "walk2"] {
         let t = read_trial(&root.join(format!("{trial}.trc")), &ReadOptions::default()).unwrap();
         let an = analyse(&t, &EventOptions::default()).unwrap();
-        let reference: Vec<(Side, EventKind, f64)> = events
-            .iter()
-            .filter(|r| r[0] == trial)
-            .map(|r| {
-                (
-                    Side::parse(&r[1]).unwrap(),
-                    kind(&r[2]),
-                    r[3].parse().unwrap(),
-                )
-            })
-            .collect();
+        let reference = reference_rows(&events, 1, |r| r[0] == trial);
         worst = worst.max(check_events(trial, &an.events.force, &reference));
         n += reference.len();
     }
