@@ -47,6 +47,10 @@ fn stage(dir: &Path, which: &str) -> HashMap<(String, i64), (f64, f64)> {
 }
 
 fn calibrate(input: &Path, out: &Path) {
+    calibrate_with(input, out, &[]);
+}
+
+fn calibrate_with(input: &Path, out: &Path, extra: &[&str]) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let status = Command::new(env!("CARGO_BIN_EXE_gaitfit"))
         .arg("calibrate")
@@ -55,6 +59,7 @@ fn calibrate(input: &Path, out: &Path) {
         .arg(root.join("fits"))
         .arg("--out")
         .arg(out)
+        .args(extra)
         .status()
         .expect("run gaitfit calibrate");
     assert!(status.success(), "gaitfit calibrate failed: {status}");
@@ -125,5 +130,42 @@ fn schreiber_2014001_double_support() {
             println!("Ko–Badler {v} cm/s: {name} {g:.1}");
             assert!(g.is_finite(), "{name} {g}");
         }
+    }
+}
+
+#[test]
+#[ignore = "needs ../shared/data"]
+fn schreiber_2014001_carried_ko_badler_keeps_the_subjects_knee() {
+    // `--kb-variant carried` draws each speed from the subject's own walk at the other speed
+    // with that walk's measured angle curves carried in W: the feet are still the paper's (the
+    // same step length and cadence), and the knee, which the paper's rigid drawing misses most,
+    // comes nearer the subject's own (measured against the markers of the generated trial).
+    let dir = gaitfit::shared_data::require("schreiber2019/2014001/dynamic");
+    let paper = tempfile::tempdir().expect("temp dir");
+    let carried = tempfile::tempdir().expect("temp dir");
+    calibrate_with(&dir, paper.path(), &["--kb-variant", "paper"]);
+    calibrate_with(&dir, carried.path(), &["--kb-variant", "carried"]);
+    let (p, c) = (
+        stage(paper.path(), "ko-badler"),
+        stage(carried.path(), "ko-badler"),
+    );
+    for q in ["step_length_m", "cadence_steps_per_min"] {
+        for ((name, v), (m, g)) in c.iter().filter(|(k, _)| k.0 == q) {
+            println!("carried {v} cm/s: {name} {m:.4} → {g:.4}");
+            assert!((g - m).abs() < 0.01 * m, "carried {name} {g} vs {m}");
+        }
+    }
+    let knees: Vec<_> = c
+        .iter()
+        .filter(|(k, _)| k.0 == "knee_flexion_rms_deg")
+        .collect();
+    assert_eq!(knees.len(), 2, "C4 and C5: {c:?}");
+    for (k, (_, g)) in knees {
+        let (_, gp) = p[k];
+        println!("{} cm/s: knee RMS paper {gp:.1}°, carried {g:.1}°", k.1);
+        assert!(
+            *g < gp,
+            "{k:?}: carried {g} not nearer than the paper's {gp}"
+        );
     }
 }

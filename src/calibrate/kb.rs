@@ -16,8 +16,9 @@ use super::{measure_generated, Subject};
 use crate::events::{Gait, Side};
 use crate::generator::generalize::compare::{
     compare, mean_scores, measured_stride, schreiber_leg, MeanScores, MeasuredStride, Target,
+    Variant,
 };
-use crate::generator::generalize::figure::{metadata, walk_motion, StepPlan};
+use crate::generator::generalize::figure::{metadata, walk_motion_with, StepPlan};
 use crate::generator::generalize::{default_alpha, Generalizer};
 use crate::generator::skeleton::Skeleton;
 use crate::ingest::{read_trial, ReadOptions};
@@ -37,13 +38,16 @@ pub fn source_for(subject: &Subject, target: usize) -> Option<usize> {
 
 /// Generates condition `target` of `subject` by Ko–Badler from the walk of condition `source`
 /// (`steps` steps at `fps`): the first stride (right leg, else left) of the source trial that
-/// builds into a step is the prototype.
+/// builds into a step is the prototype. With [`Variant::Carried`] the stride's measured
+/// hip/knee/ankle curves are carried in W (the paper's feet, the hip placed where the drawn
+/// angles come nearest them, [`crate::generator::generalize::carried`]).
 pub fn drive_kb(
     subject: &Subject,
     target: usize,
     source: usize,
     fps: f64,
     steps: usize,
+    variant: Variant,
 ) -> Result<Driven, String> {
     let src = &subject.conditions[source];
     let trial = read_trial(Path::new(&src.path), &ReadOptions::default())
@@ -80,15 +84,35 @@ pub fn drive_kb(
             steps.max(4)
         ];
         let skeleton = Skeleton::from_height(h, mass).map_err(|e| e.to_string())?;
-        let meta = metadata(&g, h, &stride.prototype.source);
-        let (motion, rep) =
-            walk_motion(&g, skeleton, &plan, Side::Right, fps, meta).map_err(|e| e.to_string())?;
+        let carried = match variant {
+            Variant::Paper => None,
+            Variant::Carried => Some(
+                stride
+                    .prototype
+                    .carried()
+                    .map_err(|e| e.to_string())?
+                    .ok_or("the measured stride carries no angle curves")?,
+            ),
+        };
+        let mut meta = metadata(&g, h, &stride.prototype.source);
+        meta.push("kb_variant", variant.name());
+        let (motion, rep) = walk_motion_with(
+            &g,
+            carried.as_ref(),
+            skeleton,
+            &plan,
+            Side::Right,
+            fps,
+            meta,
+        )
+        .map_err(|e| e.to_string())?;
         let note = format!(
-            "Ko–Badler: prototype {} {side} stride (step {:.3} m), generalized to {:.3} m in {:.3} s; hip lowered at most {:.3} m to reach the feet",
+            "Ko–Badler ({} variant): prototype {} {side} stride (step {:.3} m), generalized to {:.3} m in {:.3} s; hip lowered at most {:.3} m to reach the feet",
             src.trial,
             g.prototype().step_length(),
             q.step_length_m,
             60.0 / q.cadence_steps_per_min,
+            variant.name(),
             rep.max_hip_drop_m
         );
         return Ok(Driven {
@@ -170,7 +194,12 @@ pub fn leave_one_out(subjects: &[&Subject]) -> Option<KbLeaveOneOut> {
 /// The Ko–Badler stage of a walking subject with two or more conditions: per condition, the
 /// measurement of its generalization from the nearest other condition (`None` for runs and
 /// single-condition subjects).
-pub fn kb_stage(subject: &Subject, fps: f64, steps: usize) -> Option<super::solve::Stage> {
+pub fn kb_stage(
+    subject: &Subject,
+    fps: f64,
+    steps: usize,
+    variant: Variant,
+) -> Option<super::solve::Stage> {
     if subject.gait != Gait::Walk || subject.conditions.len() < 2 {
         return None;
     }
@@ -178,7 +207,7 @@ pub fn kb_stage(subject: &Subject, fps: f64, steps: usize) -> Option<super::solv
     let generated = (0..subject.conditions.len())
         .map(|c| {
             let source = source_for(subject, c).ok_or("no other condition")?;
-            let d = drive_kb(subject, c, source, fps, steps)?;
+            let d = drive_kb(subject, c, source, fps, steps, variant)?;
             notes.extend(d.notes.iter().cloned());
             measure_generated(&d, Gait::Walk).map_err(|e| e.to_string())
         })

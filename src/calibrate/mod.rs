@@ -20,6 +20,7 @@ pub mod solve;
 use crate::events::input::{expand_inputs, read_input};
 use crate::events::steps::subject_label;
 use crate::events::{EventError, Gait};
+pub use crate::generator::generalize::compare::Variant;
 use crate::ingest::types::Trial;
 use crate::ingest::ReadOptions;
 use drive::{DriveOptions, Relations};
@@ -67,6 +68,9 @@ pub struct CalibrateOptions {
     pub drive: DriveOptions,
     /// Gauss–Newton iterations at most.
     pub max_iters: u64,
+    /// The Ko–Badler variant of the `ko-badler` stage (the paper's drawing, or the subject's
+    /// measured angle curves carried in W).
+    pub kb_variant: Variant,
 }
 
 impl Default for CalibrateOptions {
@@ -77,6 +81,7 @@ impl Default for CalibrateOptions {
             gait: None,
             drive: DriveOptions::default(),
             max_iters: 8,
+            kb_variant: Variant::Paper,
         }
     }
 }
@@ -387,6 +392,8 @@ pub struct Calibration {
     pub drive: DriveOptions,
     /// Ko–Badler leave-one-out across the walking subjects (paper, carried, naive scaling).
     pub kb_leave_one_out: Option<kb::KbLeaveOneOut>,
+    /// The Ko–Badler variant the `ko-badler` stage generated with.
+    pub kb_variant: Variant,
 }
 
 /// Calibrates every subject (`progress` is called with each subject's one-line summary).
@@ -401,7 +408,12 @@ pub fn calibrate(
     let mut out = Vec::new();
     for (i, s) in subjects.into_iter().enumerate() {
         let mut r = solve::calibrate_subject(s, &rel, opts)?;
-        r.kb = kb::kb_stage(&r.subject, opts.drive.fps, opts.drive.steps);
+        r.kb = kb::kb_stage(
+            &r.subject,
+            opts.drive.fps,
+            opts.drive.steps,
+            opts.kb_variant,
+        );
         progress(i + 1, n, &r);
         out.push(r);
     }
@@ -413,6 +425,7 @@ pub fn calibrate(
         failed,
         drive: opts.drive,
         kb_leave_one_out,
+        kb_variant: opts.kb_variant,
     })
 }
 

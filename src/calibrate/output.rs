@@ -365,9 +365,12 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         h.push_str("</table>");
         // Residual table.
         let kb_head = if r.kb.is_some() {
-            "<th>Ko–Badler (resid.)</th>"
+            format!(
+                "<th>Ko–Badler, {} variant (resid.)</th>",
+                cal.kb_variant.name()
+            )
         } else {
-            ""
+            String::new()
         };
         let _ = write!(h, "<table><tr><th>trial</th><th>speed m/s</th><th>quantity</th><th>measured</th><th>relations (resid.)</th><th>calibrated (resid.)</th>{kb_head}</tr>");
         let kb_cell = |c: usize, f: &dyn Fn(&Result<Measurement, String>) -> String| match &r.kb {

@@ -1,5 +1,5 @@
 //! `gaitfit calibrate`: the closing loop as a command (library: [`crate::calibrate`]).
-use crate::calibrate::{calibrate, output, CalibrateOptions};
+use crate::calibrate::{calibrate, output, CalibrateOptions, Variant};
 use crate::events::Gait;
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -31,6 +31,16 @@ pub struct Args {
     /// Gauss–Newton iterations at most.
     #[arg(long, default_value_t = 8)]
     pub max_iters: u64,
+    /// Ko–Badler variant of the `ko-badler` stage (walking subjects with two or more speeds):
+    /// `paper` (W's rigid drawing, eqs. 11–12, 25–48) or `carried` (the subject's measured
+    /// hip/knee/ankle curves kept in W: the paper's feet, the hip placed where the drawn angles
+    /// come nearest them).
+    #[arg(
+        long = "kb-variant",
+        value_name = "paper|carried",
+        default_value = "paper"
+    )]
+    pub kb_variant: Variant,
 }
 
 fn parse_gait(s: &str) -> Result<Gait, String> {
@@ -54,6 +64,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             steps: args.steps,
         },
         max_iters: args.max_iters,
+        kb_variant: args.kb_variant,
     };
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new_spinner();

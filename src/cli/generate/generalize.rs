@@ -295,13 +295,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
         })?),
     };
     let mut meta = metadata(&g, args.height, &source);
-    meta.push(
-        "kb_variant",
-        match args.kb_variant {
-            Variant::Paper => "paper",
-            Variant::Carried => "carried",
-        },
-    );
+    meta.push("kb_variant", args.kb_variant.name());
     let (motion, report) = walk_motion_with(
         &g,
         carried.as_ref(),

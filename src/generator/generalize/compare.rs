@@ -69,6 +69,16 @@ pub enum Variant {
     Carried,
 }
 
+impl Variant {
+    /// The variant's name as `--kb-variant` spells it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Variant::Paper => "paper",
+            Variant::Carried => "carried",
+        }
+    }
+}
+
 impl std::str::FromStr for Variant {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
