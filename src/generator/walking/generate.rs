@@ -25,7 +25,7 @@ pub use super::draw::sagittal_angles;
 use super::draw::*;
 pub use super::first_step::FIRST_TOE_OFF_THIGH;
 use super::first_step::*;
-use super::pelvis_drop::{flat_drop, PelvisDrop, PelvisLowering, PELVIS_SMOOTH};
+use super::pelvis_drop::{flat_drop, pelvis_smooth_tau, PelvisDrop, PelvisLowering};
 pub use super::WalkOptions;
 
 /// What happened in one step: its constraints, the shooting effort and how well each phase met
@@ -413,7 +413,8 @@ pub fn generate_steps(
             end: t_step,
         };
         // The drawn pelvis height: the least-bending curve below the simulated hip lowered by
-        // the flat foot's drop (`PELVIS_SMOOTH`), equal to it at both heel strikes.
+        // the flat foot's drop (low-passed at twice the step frequency, `pelvis_smooth_tau`),
+        // equal to it at both heel strikes.
         let lowering = {
             let n = ((t_step / 2e-3).ceil() as usize).max(8);
             let h = t_step / n as f64;
@@ -424,7 +425,7 @@ pub fn generate_steps(
                 .zip(&sim)
                 .map(|(&t, &y)| drop.at(t) - y)
                 .collect();
-            smooth_roll(&times, &mut below, 0, false, PELVIS_SMOOTH * t_step);
+            smooth_roll(&times, &mut below, 0, false, pelvis_smooth_tau(t_step));
             let d = (0..=n)
                 .map(|i| (sim[i] + below[i]).max(drop.at(times[i])))
                 .collect();

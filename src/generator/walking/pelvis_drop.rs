@@ -73,7 +73,7 @@ pub(super) fn flat_drop(hip: [f64; 2], dz: f64, ankle: [f64; 2], reach: f64) -> 
 /// spline through samples on a uniform grid (C², so the swing leg hanging from the drawn
 /// pelvis gets its rate and acceleration), 0 at both heel strikes. Built by
 /// `generate` from the [`PelvisDrop`] and the least-bending pelvis height below it
-/// (`draw::smooth_roll`; see [`PELVIS_SMOOTH`]).
+/// (`draw::smooth_roll`; see [`PELVIS_CUTOFF_STEP_HARMONIC`]).
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct PelvisLowering {
     /// Sample spacing, s.
@@ -84,10 +84,20 @@ pub(super) struct PelvisLowering {
     m: Vec<f64>,
 }
 
-/// Time scale of the drawn pelvis height's smoothing, as a fraction of the step's duration: the
-/// simulated hip's loading-response dip after heel strike (≈ 0.15 of the step, 5–7 mm) is
-/// drawn as the least-bending curve below it (`draw::smooth_roll`'s `τ`).
-pub const PELVIS_SMOOTH: f64 = 0.08;
+/// Cutoff of the drawn pelvis height's smoothing, in multiples of the step frequency.
+/// `draw::smooth_roll`'s penalty `τ⁴ ∫ ÿ²` is a low-pass of gain `1 / (1 + (ωτ)⁴)`, ½ at
+/// `ω = 1/τ`. The pelvis rises and falls once per step, so the cutoff at the step's second
+/// harmonic passes that oscillation (gain 0.94) and removes the simulated stance spring's
+/// loading-response dip after heel strike (≈ 0.15 of a step, 5–7 mm: content from the ~6th
+/// harmonic up, gain ≤ 0.012).
+pub const PELVIS_CUTOFF_STEP_HARMONIC: f64 = 2.0;
+
+/// `draw::smooth_roll`'s time scale `τ` for a step lasting `t_step` s: the cutoff
+/// [`PELVIS_CUTOFF_STEP_HARMONIC`] × the step frequency, `τ = t_step / (2π · that multiple)`
+/// (≈ 0.080 × `t_step`).
+pub(super) fn pelvis_smooth_tau(t_step: f64) -> f64 {
+    t_step / (std::f64::consts::TAU * PELVIS_CUTOFF_STEP_HARMONIC)
+}
 
 impl PelvisLowering {
     /// The natural cubic spline through `d` (at least 3 samples) spaced `h` s apart.
