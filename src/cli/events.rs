@@ -100,6 +100,12 @@ pub struct Args {
     /// Marker low-pass cutoff, Hz.
     #[arg(long, default_value_t = 6.0)]
     pub marker_cutoff: f64,
+    /// Walking heel strike from markers (foot-speed detector): fraction (the heel's speed over
+    /// the ground falls through 0.5 × the walking speed, Bonci et al. 2022) or tangent (the
+    /// tangent at the steepest descent of the heel's speed reaches zero: scale-free, recall
+    /// 1.000 on the shared walks, reports/events.md).
+    #[arg(long, default_value = "fraction", value_name = "RULE")]
+    pub walk_heel_strike: String,
     /// Matching tolerance for --compare, ms.
     #[arg(long, default_value_t = 60.0)]
     pub tolerance_ms: f64,
@@ -145,6 +151,15 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     opts.force.correct_drift = args.correct_drift;
     opts.force.bridge_dropouts = args.bridge_dropouts;
     opts.kinematic.cutoff_hz = args.marker_cutoff;
+    opts.kinematic.walk_heel_strike = crate::events::kinematic::WalkHeelStrike::parse(
+        &args.walk_heel_strike,
+    )
+    .with_context(|| {
+        format!(
+            "--walk-heel-strike {}: use tangent or fraction",
+            args.walk_heel_strike
+        )
+    })?;
     Ok((read, opts))
 }
 

@@ -32,6 +32,9 @@ use super::{path_of, EventError, EventKind, EventSource, GaitEvent, Side};
 use crate::ingest::types::{MarkerSet, Setting, Trial};
 use serde::{Deserialize, Serialize};
 
+mod walk;
+pub use walk::WalkHeelStrike;
+
 /// Kinematic detection settings.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct KinematicOptions {
@@ -59,13 +62,19 @@ pub struct KinematicOptions {
     /// measures both).
     #[serde(default = "default_hs_fraction")]
     pub hs_speed_fraction: f64,
+    /// Foot-speed detector's heel-strike rule (default: the fraction rule above; the
+    /// scale-free tangent onset is the alternative, see [`WalkHeelStrike`]).
+    #[serde(default)]
+    pub walk_heel_strike: WalkHeelStrike,
     /// Foot-speed detector: toe off when the toe's speed over the ground rises above this
     /// fraction of the walking speed (default 0.8, Bonci et al. 2022).
     #[serde(default = "default_to_fraction")]
     pub to_speed_fraction: f64,
     /// Running foot detector ([`Kinematics::run_foot`]): low-pass cutoff of the heel,
     /// metatarsal and toe markers whose derivatives it reads, Hz (default 15; chosen on Hamner
-    /// subject01 Run_2 and Run_3, where 10–20 Hz give the same events within 1 ms).
+    /// subject01 Run_2 and Run_3, where 10–20 Hz give the same events within 1 ms). The
+    /// walking tangent heel strike ([`WalkHeelStrike::Tangent`]) reads the heel's speed and its
+    /// derivative on the heel low-passed here too.
     #[serde(default = "default_run_cutoff")]
     pub run_cutoff_hz: f64,
     /// Running foot detector: toe off when the toe's 3-D speed over the ground rises through
@@ -101,6 +110,7 @@ impl Default for KinematicOptions {
             min_excursion_m: 0.05,
             edge_frames: 2,
             hs_speed_fraction: default_hs_fraction(),
+            walk_heel_strike: WalkHeelStrike::default(),
             to_speed_fraction: default_to_fraction(),
             run_cutoff_hz: default_run_cutoff(),
             run_to_speed_fraction: default_run_to_fraction(),
@@ -153,7 +163,8 @@ pub struct Kinematics {
     /// Left and right legs (index 0 left, 1 right).
     pub legs: [LegTrajectories; 2],
     /// Heel, metatarsal and toe of each leg (index 0 left, 1 right) low-passed at
-    /// [`KinematicOptions::run_cutoff_hz`], for the running foot detector's derivatives.
+    /// [`KinematicOptions::run_cutoff_hz`], for the running foot detector's derivatives and
+    /// the walking tangent heel strike's.
     #[serde(default)]
     pub run_feet: [LegTrajectories; 2],
     /// The marker map in use.
@@ -774,99 +785,6 @@ impl Kinematics {
         let mut rel: Vec<f64> = pv.iter().map(|v| self.fwd(v) - ground).collect();
         let speed = median(&mut rel)?;
         (speed > 0.0).then_some((ground, speed))
-    }
-
-    /// Two-stage walking events (Bonci et al. 2022, rearfoot contacts): each Zeni event of
-    /// `seeds` opens a search window — heel strike: the first time in [−0.1 s, +0.2 s] around
-    /// the Zeni heel strike that the heel's 3-D speed over the ground falls through
-    /// `hs_speed_fraction` × the walking speed; toe off: the first time in [−0.15 s, +0.1 s]
-    /// around the Zeni toe off that the toe's rises through `to_speed_fraction` × the walking
-    /// speed (crossings interpolated linearly). Speeds are over the ground: on a treadmill the
-    /// belt's velocity (see [`Kinematics::ground_and_walking_speed`]) is removed first. A seed
-    /// with no crossing in its window gives no event. Walking only: the thresholds are
-    /// fractions of a walking speed and were published for walking.
-    pub fn foot_speed(&self, seeds: &[GaitEvent], opts: &KinematicOptions) -> Vec<GaitEvent> {
-        let mut out = Vec::new();
-        let Some((ground, speed)) = self.ground_and_walking_speed(seeds) else {
-            return out;
-        };
-        let n = self.time_s.len();
-        let fwd_axis = self.forward;
-        let ground_vel = ground * self.forward_sign;
-        let speed_over_ground = |x: &[[f64; 3]]| -> Vec<f64> {
-            self.velocity(x)
-                .into_iter()
-                .map(|mut v| {
-                    v[fwd_axis] -= ground_vel;
-                    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-                })
-                .collect()
-        };
-        for side in [Side::Left, Side::Right] {
-            let l = self.leg(side);
-            let (Some(heel), Some(toe)) = (&l.heel, &l.toe) else {
-                continue;
-            };
-            let (sh, st) = (speed_over_ground(heel), speed_over_ground(toe));
-            // Record ends: an event whose Zeni extremum the record cuts has no seed. When the
-            // foot's first seed is a toe off the foot was on the ground at the start, so its
-            // heel strike may lie just inside the record: a heel seed opens [start, toe off
-            // − 0.2 s]; it finds the heel strike only if the heel is still faster than the
-            // level at the first frame (one Schreiber heel, 2014015_C4_04 left, is at 0.35 ×
-            // speed when the record starts 63 ms before the plate's 20 N: its crossing of 0.5 ×
-            // speed precedes the record, so no event). Likewise a foot whose last seed is a
-            // heel strike may lift before the end ([heel strike + 0.25 s, end]), and one whose last seed is a toe off may land
-            // ([toe off + 0.2 s, end]). A window with no crossing gives no event.
-            let mine: Vec<&GaitEvent> = seeds.iter().filter(|e| e.side == side).collect();
-            let mut extra: Vec<(EventKind, usize, usize)> = Vec::new();
-            let t_end = self.time_s[n - 1];
-            if let Some(first) = mine.first() {
-                if first.kind == EventKind::ToeOff && first.time_s - 0.2 > self.time_s[0] {
-                    extra.push((EventKind::HeelStrike, 0, self.frame_at(first.time_s - 0.2)));
-                }
-            }
-            if let Some(last) = mine.last() {
-                let (kind, gap) = match last.kind {
-                    EventKind::HeelStrike => (EventKind::ToeOff, 0.25),
-                    _ => (EventKind::HeelStrike, 0.2),
-                };
-                if last.time_s + gap < t_end {
-                    extra.push((kind, self.frame_at(last.time_s + gap), n - 1));
-                }
-            }
-            for (kind, a, b) in extra {
-                let (s, level, falling) = match kind {
-                    EventKind::HeelStrike => (&sh, opts.hs_speed_fraction * speed, true),
-                    _ => (&st, opts.to_speed_fraction * speed, false),
-                };
-                if let Some(time_s) = self.level_crossing(s, level, falling, a, b) {
-                    out.push(GaitEvent {
-                        time_s,
-                        side,
-                        kind,
-                        source: EventSource::FootSpeed,
-                    });
-                }
-            }
-            for e in seeds.iter().filter(|e| e.side == side) {
-                let (s, level, falling, lo, hi) = match e.kind {
-                    EventKind::HeelStrike => (&sh, opts.hs_speed_fraction * speed, true, -0.1, 0.2),
-                    EventKind::ToeOff => (&st, opts.to_speed_fraction * speed, false, -0.15, 0.1),
-                    _ => continue,
-                };
-                let (a, b) = (self.frame_at(e.time_s + lo), self.frame_at(e.time_s + hi));
-                if let Some(time_s) = self.level_crossing(s, level, falling, a, b) {
-                    out.push(GaitEvent {
-                        time_s,
-                        side,
-                        kind: e.kind,
-                        source: EventSource::FootSpeed,
-                    });
-                }
-            }
-        }
-        out.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
-        out
     }
 
     /// Running events from the foot markers (treadmill or overground). Stances and swings are
