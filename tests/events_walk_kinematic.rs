@@ -13,13 +13,14 @@
 //! system), held out. 12 of Schreiber's 24 plate heel strikes lie in the first 0.1 s of their
 //! record, one BMClab plate event in the first and one in the last 0.1 s.
 //!
-//! Heel strike by the tangent onset (`--walk-heel-strike tangent`, scale-free: where the
+//! Heel strike by the tangent onset (`--events kinematic`'s default, scale-free: where the
 //! tangent at the steepest descent of the heel's speed over the ground reaches zero), aim of
 //! Build item 2: recall ≥ 0.99 including record starts and ends, mean within 15 ms. Measured:
 //! train −0.9 ± 9.2 ms, held out +1.2 ± 12.0 ms, all 12 +0.2 ± 10.5 ms, BMClab −6.8 ± 8.3 ms,
 //! recall 1.000 everywhere (gaitkit's BIKE on the same 12: −20.2 ± 12.1 ms).
 //!
-//! Heel strike by Bonci's 0.5 × walking speed (`fraction`, the default) — aim of issue 19's
+//! Heel strike by Bonci's 0.5 × walking speed (`--walk-heel-strike fraction`; the default of
+//! `--events foot-speed` and of auto's marker-only walks) — aim of issue 19's
 //! done-when: mean |error| ≤ 15 ms, SD ≤ 12 ms, recall ≥ 0.95 including record starts. Its
 //! recall is 11 of 12 on the held-out Schreiber subjects (2014015_C4_04's left heel strike,
 //! whose crossing precedes the record), and on BMClab its heel strike is 16.6 ms early on
@@ -92,10 +93,11 @@ fn score(files: &[PathBuf], rule: Option<f64>) -> (BTreeMap<EventKind, KindCount
     };
     match rule {
         Some(f) => {
-            opts.kinematic.walk_heel_strike = WalkHeelStrike::Fraction;
+            opts.kinematic.walk_heel_strike = Some(WalkHeelStrike::Fraction);
             opts.kinematic.hs_speed_fraction = f;
         }
-        None => opts.kinematic.walk_heel_strike = WalkHeelStrike::Tangent,
+        // `--events kinematic`'s default.
+        None => assert_eq!(opts.kinematic.walk_heel_strike, None),
     }
     let mut all: BTreeMap<EventKind, KindCounts> = BTreeMap::new();
     let (mut at_start, mut at_end) = (0, 0);

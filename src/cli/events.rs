@@ -100,12 +100,13 @@ pub struct Args {
     /// Marker low-pass cutoff, Hz.
     #[arg(long, default_value_t = 6.0)]
     pub marker_cutoff: f64,
-    /// Walking heel strike from markers (foot-speed detector): fraction (the heel's speed over
-    /// the ground falls through 0.5 × the walking speed, Bonci et al. 2022) or tangent (the
-    /// tangent at the steepest descent of the heel's speed reaches zero: scale-free, recall
-    /// 1.000 on the shared walks, reports/events.md).
-    #[arg(long, default_value = "fraction", value_name = "RULE")]
-    pub walk_heel_strike: String,
+    /// Walking heel strike from markers (foot-speed detector): tangent (the tangent at the
+    /// steepest descent of the heel's speed over the ground reaches zero: scale-free, recall
+    /// 1.000 on the shared walks, reports/events.md; the default of --events kinematic) or
+    /// fraction (the heel's speed falls through 0.5 × the walking speed, Bonci et al. 2022;
+    /// the default of --events foot-speed and auto).
+    #[arg(long, value_name = "RULE")]
+    pub walk_heel_strike: Option<String>,
     /// Matching tolerance for --compare, ms.
     #[arg(long, default_value_t = 60.0)]
     pub tolerance_ms: f64,
@@ -151,15 +152,11 @@ fn options(args: &Args) -> anyhow::Result<(ReadOptions, EventOptions)> {
     opts.force.correct_drift = args.correct_drift;
     opts.force.bridge_dropouts = args.bridge_dropouts;
     opts.kinematic.cutoff_hz = args.marker_cutoff;
-    opts.kinematic.walk_heel_strike = crate::events::kinematic::WalkHeelStrike::parse(
-        &args.walk_heel_strike,
-    )
-    .with_context(|| {
-        format!(
-            "--walk-heel-strike {}: use tangent or fraction",
-            args.walk_heel_strike
-        )
-    })?;
+    if let Some(r) = &args.walk_heel_strike {
+        let rule = crate::events::kinematic::WalkHeelStrike::parse(r)
+            .with_context(|| format!("--walk-heel-strike {r}: use tangent or fraction"))?;
+        opts.kinematic.walk_heel_strike = Some(rule);
+    }
     Ok((read, opts))
 }
 

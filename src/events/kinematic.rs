@@ -62,10 +62,14 @@ pub struct KinematicOptions {
     /// measures both).
     #[serde(default = "default_hs_fraction")]
     pub hs_speed_fraction: f64,
-    /// Foot-speed detector's heel-strike rule (default: the fraction rule above; the
-    /// scale-free tangent onset is the alternative, see [`WalkHeelStrike`]).
+    /// Foot-speed detector's heel-strike rule ([`WalkHeelStrike`]). `None` (default): the
+    /// scale-free tangent onset when the markers' events are asked for
+    /// ([`super::PrimarySource::Kinematic`], `--events kinematic`), the fraction rule above
+    /// otherwise (`--events foot-speed`, and the automatic choice's fallback for marker-only
+    /// walks, which builds `data/walk_bmclab.csv`'s Winter row and the KLAW closing-the-loop
+    /// checks: switching it moves the fits, a coordinated regeneration).
     #[serde(default)]
-    pub walk_heel_strike: WalkHeelStrike,
+    pub walk_heel_strike: Option<WalkHeelStrike>,
     /// Foot-speed detector: toe off when the toe's speed over the ground rises above this
     /// fraction of the walking speed (default 0.8, Bonci et al. 2022).
     #[serde(default = "default_to_fraction")]
@@ -110,7 +114,7 @@ impl Default for KinematicOptions {
             min_excursion_m: 0.05,
             edge_frames: 2,
             hs_speed_fraction: default_hs_fraction(),
-            walk_heel_strike: WalkHeelStrike::default(),
+            walk_heel_strike: None,
             to_speed_fraction: default_to_fraction(),
             run_cutoff_hz: default_run_cutoff(),
             run_to_speed_fraction: default_run_to_fraction(),

@@ -344,7 +344,13 @@ pub fn analyse(trial: &Trial, opts: &EventOptions) -> Result<Analysis, EventErro
         None => looks_like_walking(&zc),
     };
     let fs = match &kin {
-        Some(k) if walking => k.foot_speed(&zc, &opts.kinematic),
+        Some(k) if walking => {
+            let mut ko = opts.kinematic.clone();
+            if ko.walk_heel_strike.is_none() && opts.primary == PrimarySource::Kinematic {
+                ko.walk_heel_strike = Some(kinematic::WalkHeelStrike::Tangent);
+            }
+            k.foot_speed(&zc, &ko)
+        }
         _ => Vec::new(),
     };
     let fj = match &kin {

@@ -3,7 +3,8 @@
 //! Toe off (both rules): Bonci et al. (2022), the toe marker's 3-D speed over the ground rising
 //! through 0.8 × the walking speed in a window around each Zeni toe off.
 //!
-//! Heel strike, tangent onset ([`WalkHeelStrike::Tangent`]): the landing heel decelerates from its
+//! Heel strike, tangent onset ([`WalkHeelStrike::Tangent`], the default of `--events
+//! kinematic`): the landing heel decelerates from its
 //! swing speed to rest; the heel strike is where the tangent at the steepest point of that
 //! descent reaches zero speed. Nothing in it is a fraction of the walking speed: the time
 //! comes from the shape of the heel's own deceleration, so it neither moves with the walking
@@ -14,22 +15,22 @@
 //! pipeline already uses where it differentiates the foot markers twice (the running foot
 //! detector's impact accelerations), not the 6 Hz of the positions.
 //!
-//! Heel strike, fraction ([`WalkHeelStrike::Fraction`], the default): Bonci's rearfoot rule, the heel's
+//! Heel strike, fraction ([`WalkHeelStrike::Fraction`], the default otherwise): Bonci's rearfoot rule, the heel's
 //! 3-D speed over the ground falling through `hs_speed_fraction` × the walking speed.
 use super::{EventKind, EventSource, GaitEvent, KinematicOptions, Kinematics, Side};
 use serde::{Deserialize, Serialize};
 
 /// How the walking foot-speed detector times heel strike.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum WalkHeelStrike {
     /// The tangent at the steepest descent of the heel's speed over the ground, extrapolated
-    /// to zero speed (see the module documentation; scale-free).
+    /// to zero speed (see the module documentation; scale-free; the default of
+    /// `--events kinematic`).
     Tangent,
     /// The heel's speed over the ground falling through
     /// [`KinematicOptions::hs_speed_fraction`] × the walking speed (Bonci et al. 2022; the
-    /// default).
-    #[default]
+    /// default of `--events foot-speed` and of the automatic choice).
     Fraction,
 }
 
@@ -129,7 +130,7 @@ impl Kinematics {
     /// markers' speeds over the ground time the events in them. Heel strike: by
     /// `opts.walk_heel_strike` — the tangent onset (see the module documentation),
     /// searched from the foot's previous Zeni toe off (or the record start) to its next one
-    /// (or the record end), or (default) Bonci's first fall of the heel speed through
+    /// (or the record end), or Bonci's first fall of the heel speed through
     /// `hs_speed_fraction` × the walking speed in [−0.1 s, +0.2 s] around the Zeni heel
     /// strike. Toe off: the first time in [−0.15 s, +0.1 s] around the Zeni toe off that the
     /// toe's speed rises through `to_speed_fraction` × the walking speed (crossings
@@ -201,7 +202,7 @@ impl Kinematics {
             // Heel strikes.
             let first_to = mine.first().filter(|e| e.kind == EventKind::ToeOff);
             let last_to = mine.last().filter(|e| e.kind == EventKind::ToeOff);
-            match opts.walk_heel_strike {
+            match opts.walk_heel_strike.unwrap_or(WalkHeelStrike::Fraction) {
                 WalkHeelStrike::Tangent => {
                     let to_frames: Vec<usize> = mine
                         .iter()
