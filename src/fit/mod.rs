@@ -12,6 +12,8 @@
 //!   (per-subject effects absorbed), the normal-equation solve, covariances;
 //! - [`inference`]: iid, cluster-robust CR1 and CR2 (Bell–McCaffrey) standard errors;
 //! - [`mixed`]: the random-intercept model by REML (`--random-subject`);
+//! - [`wild`]: the wild cluster bootstrap-t with Webb six-point weights (exact by enumeration
+//!   with few clusters);
 //! - [`stats`]: quantiles, LRE, r², AIC/BIC, leave-one-group-out and the seeded group bootstrap;
 //! - [`prec`]: every named tolerance of the fitting layer in one place;
 //! - [`strd`]: a reader for NIST StRD `.dat` files (the golden tests of this layer).
@@ -31,6 +33,7 @@ pub mod record;
 pub mod stats;
 pub mod strd;
 pub mod synthetic;
+pub mod wild;
 
 /// Errors of the fitting layer.
 #[derive(Debug, Error)]

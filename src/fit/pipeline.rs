@@ -68,6 +68,7 @@ mod prepare;
 mod profile;
 mod robust;
 mod sums;
+mod wild;
 use band::{step, Band};
 use describe::{design_effect, inference_record};
 use nalgebra::{DMatrix, DVector};
@@ -958,6 +959,12 @@ pub fn fit_relation(
         None
     };
 
+    // Wild cluster bootstrap-t, for fits linear in every free coefficient.
+    let wild_linear = n_bp == 0 && lay.subj_col.is_none() && col_bounds.is_none() && !weighted;
+    let wild_bootstrap = (opts.bootstrap > 0 && wild_linear && n_subj >= 2)
+        .then(|| wild::wild_record(rel, &lay, &p, &prep, &values, opts.bootstrap, opts.seed))
+        .flatten();
+
     for (i, h) in held_reason.iter().enumerate() {
         if let (false, Some(h)) = (free[i], h) {
             notes.push(format!("{}: {h}", specs[i].name));
@@ -1102,6 +1109,7 @@ pub fn fit_relation(
         weights: opts.weights.clone(),
         robust,
         bootstrap,
+        wild_bootstrap,
         random_subject: random_subject.and_then(|r| r.map_err(|why| notes.push(why)).ok()),
         notes,
     };

@@ -316,6 +316,38 @@ pub struct BootstrapRecord {
     pub unit: String,
 }
 
+/// The wild cluster bootstrap-t (see [`crate::fit::wild`]): percentile-t intervals.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WildRecord {
+    /// What was bootstrapped and how the interval is formed.
+    pub method: String,
+    /// The weight distribution.
+    pub weights: String,
+    /// Bootstrap samples evaluated (6^G when every weight pattern was enumerated).
+    pub samples: u64,
+    /// True when every weight pattern was evaluated: exact quantiles, no Monte Carlo error.
+    pub enumerated: bool,
+    /// Seed of the draws (absent when enumerated).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Per free coefficient.
+    pub coefficients: Vec<WildCoefficient>,
+}
+
+/// One coefficient's wild cluster bootstrap-t interval.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WildCoefficient {
+    /// Coefficient name (as in `coefficients`).
+    pub name: String,
+    /// The percentile-t 95 % interval `θ̂ − q*·SE_CR1` (`{ lo, hi }`).
+    #[serde(default, with = "closed_bounds")]
+    pub ci95: Option<[f64; 2]>,
+    /// The bootstrap t quantiles `q*_{0.025}`, `q*_{0.975}`.
+    pub t_quantiles: [f64; 2],
+    /// The CR1 standard error the quantiles scale (G/(G−1)·(n−1)/(n−p), as statsmodels).
+    pub se_cr1: f64,
+}
+
 /// Everything one fit produced (written to `fits/<id>.json` and `.toml`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitRecord {
@@ -393,6 +425,10 @@ pub struct FitRecord {
     /// Random-intercept REML model (`--random-subject`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub random_subject: Option<MixedRecord>,
+    /// Wild cluster bootstrap-t intervals (with `--bootstrap N`, for fits linear in every free
+    /// coefficient: no breakpoint, bound, per-subject column or weights).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wild_bootstrap: Option<WildRecord>,
     /// Notes a reader should see (held coefficients, flagged subjects, r² definition).
     pub notes: Vec<String>,
 }
