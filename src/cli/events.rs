@@ -48,7 +48,8 @@ pub struct Args {
     /// Which events build the steps: auto (force with per-foot plates, else the file's own
     /// events with the plates' in their place where the plates saw them, else the plates if they saw two steps, else the markers' method for the gait),
     /// force, kinematic (markers alone, the method for the trial's gait told from the data:
-    /// foot-speed for walks, foot-jerk for runs), foot-speed (walks: Zeni windows refined by
+    /// foot-speed for walks with the tangent heel strike, see --walk-heel-strike, foot-jerk
+    /// for runs), foot-speed (walks: Zeni windows refined by
     /// the heel and toe speed over the ground, Bonci et al. 2022), foot-jerk (runs: heel or
     /// metatarsal impact jerk at touchdown, toe speed over the ground at toe off), zeni,
     /// zeni-velocity, foot-height, reference (the file's own events, e.g. a C3D's),

@@ -167,8 +167,10 @@ pub enum PrimarySource {
     /// toe off (see [`kinematic::Kinematics::run_foot`]).
     FootJerk,
     /// The markers' method for the trial's gait, told from the data (the Zeni events: at most
-    /// heel strikes, is the other foot on the ground or in the air?): `foot-speed` for a walk,
-    /// `foot-jerk` for a run.
+    /// heel strikes, is the other foot on the ground or in the air?): `foot-speed` for a walk
+    /// (its heel strike by the tangent onset unless [`kinematic::KinematicOptions`]'s
+    /// `walk_heel_strike` says otherwise, see [`kinematic::WalkHeelStrike`]), `foot-jerk` for a
+    /// run.
     Kinematic,
     /// The events stored in the file (C3D EVENT group).
     Reference,
