@@ -84,19 +84,24 @@ fn walks_read_back_as_walks_with_their_cadence_and_step_length() {
 }
 
 /// `gaitfit generate run|walk --calibration FILE` reads a calibrated.json and applies the
-/// subject's offsets: a step-length offset of +5 cm shows in the generated plan.
+/// subject's offsets: a step-length offset of +5 cm shows in the generated plan; in format 2 an
+/// offset with a speed slope is taken at the generated speed (+5 cm at 3.0 m/s, +0.1 m per m/s:
+/// +10 cm at 3.5 m/s); a format-1 file (no slopes) still reads; an unknown format is refused
+/// with the formats it knows.
 #[test]
 fn generate_reuses_a_calibration_file() {
     use gaitfit::calibrate::{CalibratedAttr, CalibratedFile, CalibratedSubject};
     let dir = tempfile::tempdir().unwrap();
-    let attr = |name: &str, unit: &str, v: f64| CalibratedAttr {
+    let attr = |name: &str, unit: &str, v: f64, slope: Option<f64>| CalibratedAttr {
         name: name.into(),
         unit: unit.into(),
         before: 0.0,
         value: v,
         se: None,
+        slope_per_m_per_s: slope,
+        slope_se: None,
     };
-    let f = CalibratedFile {
+    let file = |slope: Option<f64>| CalibratedFile {
         format: CalibratedFile::FORMAT.into(),
         relations: "published".into(),
         subjects: vec![CalibratedSubject {
@@ -104,20 +109,36 @@ fn generate_reuses_a_calibration_file() {
             gait: Gait::Run,
             body_height_m: 1.8,
             mass_kg: 70.0,
-            speeds_m_per_s: vec![3.5],
+            speeds_m_per_s: vec![2.5, 3.5],
+            reference_speed_m_per_s: slope.map(|_| 3.0),
             attributes: vec![
-                attr("step_length_offset_m", "m", 0.05),
-                attr("flight_time_offset_s", "s", 0.0),
-                attr("bounciness_deg", "deg", 40.0),
+                attr("step_length_offset_m", "m", 0.05, slope),
+                attr("flight_time_offset_s", "s", 0.0, slope.map(|_| 0.0)),
+                attr("bounciness_deg", "deg", 40.0, None),
             ],
         }],
     };
-    let cal = dir.path().join("calibrated.json");
-    std::fs::write(&cal, serde_json::to_string(&f).unwrap()).unwrap();
-    let plan = |extra: &[&str]| -> f64 {
-        let out = dir.path().join("r.csv");
-        let plan = dir.path().join("plan.csv");
-        let mut args = vec![
+    let write = |name: &str, text: String| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p.to_str().unwrap().to_string()
+    };
+    let constant = write("c.json", serde_json::to_string(&file(None)).unwrap());
+    let sloped = write("s.json", serde_json::to_string(&file(Some(0.1))).unwrap());
+    let v1 = write(
+        "v1.json",
+        serde_json::to_string(&file(None))
+            .unwrap()
+            .replace(CalibratedFile::FORMAT, "gaitfit-calibration-1"),
+    );
+    let v9 = write(
+        "v9.json",
+        serde_json::to_string(&file(None))
+            .unwrap()
+            .replace(CalibratedFile::FORMAT, "gaitfit-calibration-9"),
+    );
+    let args = |extra: &[&str], o: &str, p: &str| -> Vec<String> {
+        let mut a: Vec<String> = [
             "generate",
             "run",
             "--speed",
@@ -126,13 +147,23 @@ fn generate_reuses_a_calibration_file() {
             "3",
             "--no-stop",
             "-o",
-        ];
+            o,
+            "--plan",
+            p,
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let plan = |extra: &[&str]| -> f64 {
+        let out = dir.path().join("r.csv");
+        let plan = dir.path().join("plan.csv");
         let (o, p) = (out.to_str().unwrap(), plan.to_str().unwrap());
-        args.extend([o, "--plan", p]);
-        args.extend(extra);
         assert_cmd::Command::cargo_bin("gaitfit")
             .unwrap()
-            .args(&args)
+            .args(args(extra, o, p))
             .assert()
             .success();
         let text = std::fs::read_to_string(&plan).unwrap();
@@ -140,9 +171,29 @@ fn generate_reuses_a_calibration_file() {
         last.split(',').nth(6).unwrap().parse().unwrap()
     };
     let base = plan(&[]);
-    let calibrated = plan(&["--calibration", cal.to_str().unwrap()]);
+    for (f, want) in [(&constant, 0.05), (&v1, 0.05), (&sloped, 0.10)] {
+        let calibrated = plan(&["--calibration", f]);
+        assert!(
+            (calibrated - base - want).abs() < 1e-3,
+            "{f}: step length {base} → {calibrated}, want +{want}"
+        );
+    }
+    let out = dir.path().join("r.csv");
+    let err = assert_cmd::Command::cargo_bin("gaitfit")
+        .unwrap()
+        .args(args(
+            &["--calibration", &v9],
+            out.to_str().unwrap(),
+            dir.path().join("p.csv").to_str().unwrap(),
+        ))
+        .assert()
+        .failure()
+        .get_output()
+        .stderr
+        .clone();
+    let err = String::from_utf8_lossy(&err);
     assert!(
-        (calibrated - base - 0.05).abs() < 1e-3,
-        "step length {base} → {calibrated}"
+        err.contains("gaitfit-calibration-9") && err.contains("gaitfit-calibration-1"),
+        "{err}"
     );
 }

@@ -93,6 +93,159 @@ pub fn attr_defs(gait: Gait) -> &'static [AttrDef; 3] {
     }
 }
 
+/// Indices (in [`attr_defs`]) of the relation offsets that may vary with speed: the
+/// step-length offset and the flight-time (run) or double-support (walk) offset. The third
+/// attribute (bounciness, leg stiffness) is the generator's own and stays one value.
+pub const SLOPED: [usize; 2] = [0, 1];
+
+/// How a subject's parameter vector gives the attributes at a speed.
+///
+/// Without slopes the parameters are the three attributes of [`attr_defs`], the same at
+/// every speed. With slopes (a subject measured at two or more speeds, so that a change with
+/// speed is identifiable) two more parameters follow, the slopes of the [`SLOPED`] offsets per
+/// m/s about the subject's reference speed `v_ref` (the mean of its speeds):
+/// `offset(v) = a + b·(v − v_ref)`. A constant offset cannot fit a subject whose deviation
+/// from the relation changes sign between speeds (Schreiber 2014001: cadence +1.7 and
+/// −2.4 steps/min at 1.43 and 2.18 m/s with one step-length offset).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AttrModel {
+    /// Walk or run.
+    pub gait: Gait,
+    /// The speed (m/s) at which the offsets are the first parameters.
+    pub reference_speed: f64,
+    /// Half the spread of the subject's speeds (m/s), the scale of a slope's finite-difference
+    /// step; `None`: no slopes.
+    pub slope_scale: Option<f64>,
+    /// Finite-difference steps of the three attributes (see [`AttrModel::for_speeds`]).
+    pub steps: [f64; 3],
+}
+
+/// One parameter of an [`AttrModel`]: finite-difference step and admissible range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamDef {
+    /// Name: the attribute's, or the attribute's with `_slope` for a slope.
+    pub name: &'static str,
+    /// Finite-difference step of the Jacobian.
+    pub step: f64,
+    /// Admissible range.
+    pub range: (f64, f64),
+}
+
+/// Frames of the generated motion that the finite-difference step of the flight or
+/// double-support offset spans at least (see [`AttrModel::for_speeds`]): the quantisation error
+/// of a difference is at most one frame at each end, so four frames keep it ≤ 50 % of the
+/// step (usually ≤ 25 %).
+pub const FD_FRAMES: f64 = 4.0;
+
+/// Names of the slope parameters, in the order of [`SLOPED`] (per gait).
+const SLOPE_NAMES: [[&str; 2]; 2] = [
+    ["step_length_offset_m_slope", "flight_time_offset_s_slope"],
+    [
+        "step_length_offset_m_slope",
+        "double_support_offset_pct_slope",
+    ],
+];
+
+impl AttrModel {
+    /// The model of a subject measured at `speeds` (m/s): slopes when `slopes` and there are
+    /// two or more distinct speeds (≥ 0.1 m/s apart), none otherwise.
+    ///
+    /// The generated motion is steady, every step alike, so its mean flight or double support
+    /// moves in whole frames (1/`fps`; in % of the cycle `100/(fps·cycle_s)`, `cycle_s` the
+    /// subject's longest measured stride time): a finite-difference step of the flight or
+    /// double-support offset below a few frames measures the quantisation, not the slope
+    /// (2014007 at 0.92 m/s: a 0.5 % step moved the double support 0.0 or 0.9 %). That offset's
+    /// step is therefore at least [`FD_FRAMES`] frames.
+    pub fn for_speeds(
+        gait: Gait,
+        speeds: &[f64],
+        slopes: bool,
+        fps: f64,
+        cycle_s: f64,
+    ) -> AttrModel {
+        let n = speeds.len().max(1) as f64;
+        let reference_speed = speeds.iter().sum::<f64>() / n;
+        let (lo, hi) = speeds
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        let half = 0.5 * (hi - lo);
+        let defs = attr_defs(gait);
+        let frame = match gait {
+            Gait::Run => 1.0 / fps,
+            Gait::Walk => 100.0 / (fps * cycle_s),
+        };
+        AttrModel {
+            gait,
+            reference_speed,
+            slope_scale: (slopes && half >= 0.05).then_some(half),
+            steps: [
+                defs[0].step,
+                defs[1].step.max(FD_FRAMES * frame),
+                defs[2].step,
+            ],
+        }
+    }
+
+    /// Number of parameters (3, or 5 with slopes).
+    pub fn len(&self) -> usize {
+        3 + if self.slope_scale.is_some() { 2 } else { 0 }
+    }
+
+    /// Never empty (there are always the three attributes).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// The parameters: the attributes, then the slopes. A slope's step moves its offset by the
+    /// offset's own step at the subject's extreme speeds; its range lets the offset cross its
+    /// whole range over that spread.
+    pub fn params(&self) -> Vec<ParamDef> {
+        let defs = attr_defs(self.gait);
+        let mut out: Vec<ParamDef> = defs
+            .iter()
+            .zip(self.steps)
+            .map(|(d, step)| ParamDef {
+                name: d.name,
+                step,
+                range: d.range,
+            })
+            .collect();
+        if let Some(half) = self.slope_scale {
+            let names = SLOPE_NAMES[usize::from(self.gait == Gait::Walk)];
+            for (k, &i) in SLOPED.iter().enumerate() {
+                let (lo, hi) = defs[i].range;
+                let r = (hi - lo) / (2.0 * half);
+                out.push(ParamDef {
+                    name: names[k],
+                    step: self.steps[i] / half,
+                    range: (-r, r),
+                });
+            }
+        }
+        out
+    }
+
+    /// The starting parameters: [`initial`] and zero slopes.
+    pub fn initial(&self, body_height: f64) -> Vec<f64> {
+        let mut p = initial(self.gait, body_height).to_vec();
+        p.resize(self.len(), 0.0);
+        p
+    }
+
+    /// The attributes at speed `v` (m/s).
+    pub fn at(&self, p: &[f64], v: f64) -> [f64; 3] {
+        let mut t = [p[0], p[1], p[2]];
+        if self.slope_scale.is_some() {
+            for (k, &i) in SLOPED.iter().enumerate() {
+                t[i] += p.get(3 + k).copied().unwrap_or(0.0) * (v - self.reference_speed);
+            }
+        }
+        t
+    }
+}
+
 /// The attributes before calibration: zero offsets and the generator's defaults.
 pub fn initial(gait: Gait, body_height: f64) -> [f64; 3] {
     match gait {
@@ -277,4 +430,45 @@ fn drive_walk(
         notes: rep.notes,
         motion,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Slopes only with two or more speeds; the offsets are the first parameters at the
+    /// reference speed and change linearly with it; the third attribute never has a slope.
+    #[test]
+    fn attr_model_slopes() {
+        let one = AttrModel::for_speeds(Gait::Run, &[3.0], true, 200.0, 0.7);
+        assert_eq!(one.len(), 3);
+        assert_eq!(one.at(&[0.1, 0.02, 40.0], 5.0), [0.1, 0.02, 40.0]);
+        let off = AttrModel::for_speeds(Gait::Run, &[2.0, 4.0], false, 200.0, 0.7);
+        assert_eq!(off.len(), 3);
+        let m = AttrModel::for_speeds(Gait::Walk, &[1.0, 1.4, 1.6], true, 200.0, 1.2);
+        assert_eq!(m.len(), 5);
+        assert!((m.reference_speed - 4.0 / 3.0).abs() < 1e-12);
+        let p = [0.01, 2.0, 30.0, 0.05, -4.0];
+        let at_ref = m.at(&p, m.reference_speed);
+        assert!((at_ref[0] - 0.01).abs() < 1e-12 && (at_ref[1] - 2.0).abs() < 1e-12);
+        let t = m.at(&p, m.reference_speed + 0.5);
+        assert!((t[0] - 0.035).abs() < 1e-12 && (t[1] - 0.0).abs() < 1e-12 && t[2] == 30.0);
+        // The slope's step moves the offset by the offset's step at the extreme speeds.
+        let d = m.params();
+        assert!((d[3].step * 0.3 - d[0].step).abs() < 1e-12);
+        assert!((d[4].step * 0.3 - d[1].step).abs() < 1e-12);
+    }
+
+    /// The flight or double-support offset's step spans FD_FRAMES frames of the generated
+    /// motion: 4 frames at 200 fps are 20 ms of flight, or 100·4/(200·1.2) % of a 1.2 s cycle.
+    #[test]
+    fn offset_step_spans_frames() {
+        let r = AttrModel::for_speeds(Gait::Run, &[3.0], false, 200.0, 0.7);
+        assert!((r.params()[1].step - 0.02).abs() < 1e-12);
+        let w = AttrModel::for_speeds(Gait::Walk, &[1.2], false, 200.0, 1.2);
+        assert!((w.params()[1].step - 100.0 * 4.0 / 240.0).abs() < 1e-12);
+        // Never below the attribute's own step.
+        let fine = AttrModel::for_speeds(Gait::Walk, &[1.2], false, 2000.0, 1.2);
+        assert_eq!(fine.params()[1].step, WALK_ATTRS[1].step);
+    }
 }

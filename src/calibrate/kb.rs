@@ -213,7 +213,7 @@ pub fn kb_stage(
         })
         .collect();
     Some(super::solve::Stage {
-        theta: [0.0; 3],
+        params: Vec::new(),
         generated,
         cost: f64::NAN,
         notes,

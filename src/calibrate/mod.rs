@@ -9,8 +9,10 @@
 //!
 //! Two stages: `relations` (the relations of `--fits`, or refitted on the inputs, with zero
 //! offsets and the generators' default attributes) and `calibrated` (the attributes of
-//! [`drive::RUN_ATTRS`] / [`drive::WALK_ATTRS`] found by Gauss–Newton, argmin's
-//! `GaussNewton`, on the objective of [`solve`]).
+//! [`drive::RUN_ATTRS`] / [`drive::WALK_ATTRS`], optionally with speed slopes on the relation
+//! offsets, found by a trust-region Gauss–Newton (argmin's `TrustRegion`) on the objective of
+//! [`solve`]). With `leave_one_speed_out`, a third stage `held-out` predicts each condition
+//! from a calibration on the subject's other conditions.
 pub mod drive;
 pub mod kb;
 pub mod measure;
@@ -66,11 +68,17 @@ pub struct CalibrateOptions {
     pub gait: Option<Gait>,
     /// Generated motions.
     pub drive: DriveOptions,
-    /// Gauss–Newton iterations at most.
+    /// Trust-region iterations at most.
     pub max_iters: u64,
     /// The Ko–Badler variant of the `ko-badler` stage (the paper's drawing, or the subject's
     /// measured angle curves carried in W).
     pub kb_variant: Variant,
+    /// Give the relation offsets a speed slope for subjects measured at two or more speeds
+    /// ([`drive::AttrModel`]); `false`: one constant offset set per subject.
+    pub speed_slopes: bool,
+    /// Also calibrate each subject once per condition without it and predict the condition
+    /// left out (stage `held-out`).
+    pub leave_one_speed_out: bool,
 }
 
 impl Default for CalibrateOptions {
@@ -81,7 +89,9 @@ impl Default for CalibrateOptions {
             gait: None,
             drive: DriveOptions::default(),
             max_iters: 8,
-            kb_variant: Variant::Paper,
+            kb_variant: Variant::Carried,
+            speed_slopes: false,
+            leave_one_speed_out: false,
         }
     }
 }
@@ -362,12 +372,15 @@ pub fn relations(
 pub struct SubjectResult {
     /// The subject.
     pub subject: Subject,
+    /// How the parameters give the attributes at a speed.
+    pub model: drive::AttrModel,
     /// Stage `relations`: the attributes before calibration and the generated measurements.
     pub before: solve::Stage,
     /// Stage `calibrated`.
     pub after: solve::Stage,
-    /// Standard errors of the calibrated attributes (Gauss–Newton covariance).
-    pub se: [Option<f64>; 3],
+    /// Standard errors of the calibrated parameters (Gauss–Newton covariance), in the order
+    /// of [`drive::AttrModel::params`].
+    pub se: Vec<Option<f64>>,
     /// Gauss–Newton iterations and objective evaluations.
     pub iterations: u64,
     /// Objective evaluations.
@@ -375,6 +388,10 @@ pub struct SubjectResult {
     /// Stage `ko-badler` (walks with another condition of the subject): each condition
     /// generalized from the subject's walk at the nearest other speed ([`kb`]).
     pub kb: Option<solve::Stage>,
+    /// Stage `held-out` (with `--leave-one-speed-out`, subjects with two or more speeds): each
+    /// condition generated with the attributes calibrated on the subject's other conditions
+    /// ([`solve::leave_one_speed_out`]); `params` empty, since they differ per condition.
+    pub held_out: Option<solve::Stage>,
 }
 
 /// Everything one `calibrate` run found.
@@ -408,6 +425,9 @@ pub fn calibrate(
     let mut out = Vec::new();
     for (i, s) in subjects.into_iter().enumerate() {
         let mut r = solve::calibrate_subject(s, &rel, opts)?;
+        if opts.leave_one_speed_out {
+            r.held_out = solve::leave_one_speed_out(&r.subject, &rel, opts)?;
+        }
         r.kb = kb::kb_stage(
             &r.subject,
             opts.drive.fps,
@@ -442,6 +462,10 @@ pub struct CalibratedSubject {
     pub mass_kg: f64,
     /// Measured speeds, m/s.
     pub speeds_m_per_s: Vec<f64>,
+    /// The speed (m/s) at which the attributes' `value`s hold when some have a slope (format
+    /// 2; absent in format 1, whose attributes are constant).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reference_speed_m_per_s: Option<f64>,
     /// The attributes.
     pub attributes: Vec<CalibratedAttr>,
 }
@@ -459,6 +483,14 @@ pub struct CalibratedAttr {
     pub value: f64,
     /// Standard error (Gauss–Newton), when identifiable.
     pub se: Option<f64>,
+    /// Change of the value per m/s of speed away from the reference speed (format 2; only the
+    /// relation offsets of subjects measured at two or more speeds have one):
+    /// value(v) = value + slope·(v − v_ref).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slope_per_m_per_s: Option<f64>,
+    /// Standard error of the slope (Gauss–Newton).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slope_se: Option<f64>,
 }
 
 /// `calibrated.json`: what `gaitfit generate run|walk --calibration FILE` reuses.
@@ -473,8 +505,12 @@ pub struct CalibratedFile {
 }
 
 impl CalibratedFile {
-    /// The format tag.
-    pub const FORMAT: &'static str = "gaitfit-calibration-1";
+    /// The format tag written: format 2 adds the offsets' speed slopes
+    /// (`reference_speed_m_per_s`, `slope_per_m_per_s`, `slope_se`).
+    pub const FORMAT: &'static str = "gaitfit-calibration-2";
+
+    /// The formats read: 1 (constant attributes) and 2.
+    pub const READ_FORMATS: [&'static str; 2] = ["gaitfit-calibration-1", Self::FORMAT];
 
     /// Reads a calibrated.json.
     pub fn read(path: &Path) -> Result<CalibratedFile, CalibrateError> {
@@ -486,10 +522,14 @@ impl CalibratedFile {
             path: path.display().to_string(),
             message: format!("not a calibrated.json: {e}"),
         })?;
-        if f.format != Self::FORMAT {
+        if !Self::READ_FORMATS.contains(&f.format.as_str()) {
             return Err(CalibrateError::Write {
                 path: path.display().to_string(),
-                message: format!("format {:?}, expected {:?}", f.format, Self::FORMAT),
+                message: format!(
+                    "format {:?}, expected one of {:?} (written by a newer gaitfit?)",
+                    f.format,
+                    Self::READ_FORMATS
+                ),
             });
         }
         Ok(f)
@@ -518,17 +558,27 @@ impl CalibratedFile {
         }
     }
 
-    /// The attribute vector of an entry, in the order of [`drive::attr_defs`].
-    pub fn theta(s: &CalibratedSubject) -> Result<[f64; 3], String> {
+    /// The attribute vector of an entry at speed `v` (m/s), in the order of
+    /// [`drive::attr_defs`]: each value plus its slope times `v` less the reference speed.
+    pub fn attributes_at(s: &CalibratedSubject, v: f64) -> Result<[f64; 3], String> {
         let defs = drive::attr_defs(s.gait);
         let mut out = [0.0; 3];
         for (o, d) in out.iter_mut().zip(defs.iter()) {
-            *o = s
+            let a = s
                 .attributes
                 .iter()
                 .find(|a| a.name == d.name)
-                .map(|a| a.value)
                 .ok_or_else(|| format!("attribute {} missing", d.name))?;
+            *o = a.value;
+            if let Some(b) = a.slope_per_m_per_s {
+                let v_ref = s.reference_speed_m_per_s.ok_or_else(|| {
+                    format!(
+                        "attribute {} has a slope but the subject has no reference_speed_m_per_s",
+                        d.name
+                    )
+                })?;
+                *o += b * (v - v_ref);
+            }
         }
         Ok(out)
     }
@@ -558,9 +608,17 @@ pub fn summary_line(r: &SubjectResult) -> String {
         Gait::Run => ("flight", 1000.0, "ms"),
         Gait::Walk => ("double support", 1.0, "% cycle"),
     };
+    let held = r.held_out.as_ref().map_or(String::new(), |h| {
+        format!(
+            "; held out (calibrated on the other speeds): {:.1} steps/min, {:.1} cm, {:.1} {punit}",
+            mean_abs(h, 0),
+            100.0 * mean_abs(h, 1),
+            pscale * mean_abs(h, 3)
+        )
+    });
     format!(
         "{} ({}, {} condition(s), {:.2}–{:.2} m/s): |Δcadence| {:.1} → {:.1} steps/min, \
-         |Δstep length| {:.1} → {:.1} cm, |Δ{pname}| {:.1} → {:.1} {punit}",
+         |Δstep length| {:.1} → {:.1} cm, |Δ{pname}| {:.1} → {:.1} {punit}{held}",
         s.name,
         s.gait,
         s.conditions.len(),

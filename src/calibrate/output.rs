@@ -1,6 +1,6 @@
 //! The outputs of `gaitfit calibrate`: `residuals.csv`, `calibrated.json` and `report.html`
 //! (one self-contained file, inline SVG, nothing from the network).
-use super::drive::attr_defs;
+use super::drive::{attr_defs, SLOPED};
 use super::measure::{rms_corr, Curves, Measurement, CYCLE_POINTS};
 use super::solve::value;
 use super::{CalibrateError, CalibratedAttr, CalibratedFile, CalibratedSubject, Calibration};
@@ -53,6 +53,9 @@ pub fn residual_rows(cal: &Calibration) -> Vec<ResidualRow> {
         let mut stages = vec![("relations", &r.before), ("calibrated", &r.after)];
         if let Some(kb) = &r.kb {
             stages.push(("ko-badler", kb));
+        }
+        if let Some(ho) = &r.held_out {
+            stages.push(("held-out", ho));
         }
         for (stage_name, stage) in stages {
             for (c, cond) in s.conditions.iter().enumerate() {
@@ -155,15 +158,23 @@ pub fn calibrated_file(cal: &Calibration) -> CalibratedFile {
                 body_height_m: r.subject.body_height_m,
                 mass_kg: r.subject.mass_kg,
                 speeds_m_per_s: r.subject.conditions.iter().map(|c| c.speed()).collect(),
+                reference_speed_m_per_s: r.model.slope_scale.map(|_| r.model.reference_speed),
                 attributes: attr_defs(r.subject.gait)
                     .iter()
                     .enumerate()
-                    .map(|(i, d)| CalibratedAttr {
-                        name: d.name.into(),
-                        unit: d.unit.into(),
-                        before: r.before.theta[i],
-                        value: r.after.theta[i],
-                        se: r.se[i],
+                    .map(|(i, d)| {
+                        // The slope of attribute i, if it has one (parameter 3 + k).
+                        let k = SLOPED.iter().position(|&j| j == i).map(|k| 3 + k);
+                        let k = k.filter(|&k| k < r.model.len());
+                        CalibratedAttr {
+                            name: d.name.into(),
+                            unit: d.unit.into(),
+                            before: r.before.params[i],
+                            value: r.after.params[i],
+                            se: r.se[i],
+                            slope_per_m_per_s: k.map(|k| r.after.params[k]),
+                            slope_se: k.and_then(|k| r.se[k]),
+                        }
                     })
                     .collect(),
             })
@@ -306,7 +317,7 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         "<h1>gaitfit calibrate</h1><p>Relations: {}. Generated motions at {} frames/s, {} steady \
          steps per condition, measured by the same event pipeline as the trials. Residual = \
          generated − measured; stage <i>relations</i>: the relations with the generators' default \
-         attributes; stage <i>calibrated</i>: the per-subject attributes found by Gauss–Newton on \
+         attributes; stage <i>calibrated</i>: the per-subject attributes found by a trust-region Gauss–Newton on \
          the weighted residual objective (weights: the measured step-to-step SD; cadence, step \
          length, flight or double support and pelvis excursion — the contact time is reported, not \
          fitted, being the step time and the flight or double support together); stage \
@@ -331,7 +342,7 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         let _ = write!(
             h,
             "<section><h2>{} — {}</h2><p>Body height {:.3} m{}; {} condition(s); objective {:.2} → {:.2} \
-             ({} Gauss–Newton iteration(s)).</p>",
+             ({} trust-region iteration(s)).</p>",
             esc(&s.name),
             s.gait,
             s.body_height_m,
@@ -356,26 +367,53 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
                 "<tr><td>{}</td><td>{}</td><td>{:.4}</td><td>{:.4}</td><td>{}</td><td style=\"text-align:left\">{}</td></tr>",
                 d.name,
                 esc(d.unit),
-                r.before.theta[i],
-                r.after.theta[i],
+                r.before.params[i],
+                r.after.params[i],
                 fmt(r.se[i], 4),
                 esc(d.doc)
             );
         }
+        if r.model.slope_scale.is_some() {
+            for (k, &i) in SLOPED.iter().enumerate() {
+                let d = &attr_defs(s.gait)[i];
+                let _ = write!(
+                    h,
+                    "<tr><td>{} slope</td><td>{} per m/s</td><td>0</td><td>{:.4}</td><td>{}</td><td style=\"text-align:left\">\
+                     change of {} per m/s away from {:.2} m/s (the value above holds there)</td></tr>",
+                    d.name,
+                    esc(d.unit),
+                    r.after.params[3 + k],
+                    fmt(r.se[3 + k], 4),
+                    d.name,
+                    r.model.reference_speed
+                );
+            }
+        }
         h.push_str("</table>");
         // Residual table.
-        let kb_head = if r.kb.is_some() {
-            format!(
-                "<th>Ko–Badler, {} variant (resid.)</th>",
-                cal.kb_variant.name()
-            )
-        } else {
-            String::new()
-        };
+        let mut extra: Vec<(String, &super::solve::Stage)> = Vec::new();
+        if let Some(kb) = &r.kb {
+            extra.push((
+                format!("Ko–Badler, {} variant (resid.)", cal.kb_variant.name()),
+                kb,
+            ));
+        }
+        if let Some(ho) = &r.held_out {
+            extra.push((
+                "held out: calibrated on the other speeds (resid.)".to_string(),
+                ho,
+            ));
+        }
+        let kb_head: String = extra
+            .iter()
+            .map(|(name, _)| format!("<th>{}</th>", esc(name)))
+            .collect();
         let _ = write!(h, "<table><tr><th>trial</th><th>speed m/s</th><th>quantity</th><th>measured</th><th>relations (resid.)</th><th>calibrated (resid.)</th>{kb_head}</tr>");
-        let kb_cell = |c: usize, f: &dyn Fn(&Result<Measurement, String>) -> String| match &r.kb {
-            Some(kb) => format!("<td>{}</td>", f(&kb.generated[c])),
-            None => String::new(),
+        let kb_cell = |c: usize, f: &dyn Fn(&Result<Measurement, String>) -> String| {
+            extra
+                .iter()
+                .map(|(_, st)| format!("<td>{}</td>", f(&st.generated[c])))
+                .collect::<String>()
         };
         for (c, cond) in s.conditions.iter().enumerate() {
             let m = &cond.measured;

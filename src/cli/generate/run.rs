@@ -100,13 +100,15 @@ fn attribute_help() -> String {
 }
 
 /// The attribute vector of `gait` for `subject` in a calibrated.json (see
-/// [`crate::calibrate::CalibratedFile`]), with a note when it was calibrated for another body
-/// height.
+/// [`crate::calibrate::CalibratedFile`]) at speed `speed` (m/s; the offsets may change with
+/// speed), with a note when it was calibrated for another body height, and when the offsets
+/// have a slope but no speed is given (the reference speed is used).
 pub(super) fn load_calibration(
     path: &std::path::Path,
     gait: Gait,
     subject: Option<&str>,
     height: f64,
+    speed: Option<f64>,
 ) -> anyhow::Result<[f64; 3]> {
     use crate::calibrate::CalibratedFile;
     let f = CalibratedFile::read(path)?;
@@ -119,7 +121,33 @@ pub(super) fn load_calibration(
             s.subject, s.body_height_m
         );
     }
-    CalibratedFile::theta(s).map_err(|e| anyhow::anyhow!("--calibration {}: {e}", path.display()))
+    let v = match (speed, s.reference_speed_m_per_s) {
+        (Some(v), _) => v,
+        (None, Some(v_ref)) => {
+            eprintln!(
+                "gaitfit: note: --calibration: {}'s offsets change with speed and no --speed is \
+                 given; they are taken at its reference speed {v_ref:.2} m/s",
+                s.subject
+            );
+            v_ref
+        }
+        (None, None) => 0.0,
+    };
+    let (lo, hi) = s
+        .speeds_m_per_s
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    if s.reference_speed_m_per_s.is_some() && (v < lo - 0.25 || v > hi + 0.25) {
+        eprintln!(
+            "gaitfit: note: --calibration: {v:.2} m/s is outside {}'s measured speeds \
+             {lo:.2}–{hi:.2} m/s; the offsets' speed slopes are extrapolated",
+            s.subject
+        );
+    }
+    CalibratedFile::attributes_at(s, v)
+        .map_err(|e| anyhow::anyhow!("--calibration {}: {e}", path.display()))
 }
 
 fn param_of(name: &str) -> anyhow::Result<Param> {
@@ -151,7 +179,8 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     let mut attrs = RunAttributes::defaults(height);
     let calibration = match &args.calibration {
         Some(path) => {
-            let theta = load_calibration(path, Gait::Run, c.subject.as_deref(), height)?;
+            let v = args.speed.unwrap_or(12.0 / 3.6);
+            let theta = load_calibration(path, Gait::Run, c.subject.as_deref(), height, Some(v))?;
             attrs.set(Attr::Bounciness, theta[2].to_radians())?;
             Some(theta)
         }

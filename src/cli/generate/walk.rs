@@ -165,6 +165,7 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
             Gait::Walk,
             c.subject.as_deref(),
             args.height,
+            args.speed,
         )?),
         None => None,
     };
