@@ -9,9 +9,7 @@ use super::body::Body;
 use crate::generator::GenerateError;
 use crate::relations::walk_sl_sf::WalkSlSf;
 use crate::relations::walk_tds_sf::WalkTdsSf;
-use crate::units::{
-    hz_to_steps_per_min, km_per_h_to_m_per_s, m_per_min_to_m_per_s, m_per_s_to_m_per_min,
-};
+use crate::units::{km_per_h_to_m_per_s, m_per_min_to_m_per_s, m_per_s_to_m_per_min};
 use std::path::Path;
 
 /// The two walking relations KLAW uses, from the relations layer: eq. (1) `sl / (sf·h) = k`
@@ -399,43 +397,4 @@ pub fn heel_strike(
         omega3,
         foot_pitch,
     })
-}
-
-/// The step constraints for the low-level control: durations and final conditions.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StepConstraints {
-    /// Step length, m.
-    pub step_length_m: f64,
-    /// Step frequency, steps/min.
-    pub step_freq_steps_per_min: f64,
-    /// Phase durations.
-    pub times: PhaseTimes,
-    /// Final conditions at the heel strike that ends the step.
-    pub heel_strike: HeelStrike,
-}
-
-/// Decomposes complete locomotion parameters into step constraints.
-pub fn step_constraints(
-    b: &Body,
-    l: &Locomotion,
-    rel: &WalkRelations,
-    a: &WalkAttributes,
-) -> Result<StepConstraints, GenerateError> {
-    let ahead = 0.5 * b.l0 * a.pelvic_rotation_deg.to_radians().sin();
-    Ok(StepConstraints {
-        step_length_m: l.step_length_m,
-        step_freq_steps_per_min: l.step_freq_steps_per_min,
-        times: phase_times(l.step_freq_steps_per_min, rel),
-        heel_strike: heel_strike(
-            b,
-            l.step_length_m,
-            a.ankle_heel_strike_deg.to_radians(),
-            ahead,
-        )?,
-    })
-}
-
-/// Steps per minute from a frequency in Hz (re-exported convenience for callers).
-pub fn steps_per_min(hz: f64) -> f64 {
-    hz_to_steps_per_min(hz)
 }

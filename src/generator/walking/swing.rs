@@ -27,7 +27,6 @@
 //! their toe-off and heel-strike values.
 use super::ankle_curve::PEAK_AT;
 pub use super::ankle_curve::{knee_on_circle, AnkleCurve, KNEE_BRANCH_STEP};
-use super::body::Body;
 use super::dynamics::{HipMotion, SwingModel};
 use super::foot::{FootPoints, FootShape};
 use super::integrate::{integrate, spectral_radius, stable_step};
@@ -1064,11 +1063,6 @@ fn padded(s: Solved<1>) -> Solved<2> {
         iterations: s.iterations,
         jacobian: None,
     }
-}
-
-/// The body's swing model and foot.
-pub fn swing_parts(body: &Body) -> (SwingModel, FootShape) {
-    (SwingModel::new(body), FootShape::new(body))
 }
 
 #[cfg(test)]
