@@ -94,12 +94,17 @@ impl WildT {
 }
 
 /// Per-contrast constants of the studentised statistic as a function of the weights:
-/// `t*_k(w) = βₖᵀw / √(c1·wᵀQₖw)` with `βₖ[g] = ℓₖᵀb_g` and `Qₖ = KₖᵀKₖ`,
-/// `Kₖ[g][h] = δ_gh·βₖ[g] − (X_gᵀX_g A⁻¹ℓₖ)ᵀb_h` (the sample's scaled scores are `Kₖw`).
+/// `t*_k(w) = βₖᵀw / √(c1·Σ_g (w_g βₖ[g] − νₖ[g]ᵀd)²)` with `d = Σ w_g b_g`, `βₖ[g] = ℓₖᵀb_g`,
+/// `νₖ[g] = X_gᵀX_g A⁻¹ℓₖ`; for the enumeration, the same sum as the quadratic form `wᵀQₖw`,
+/// `Qₖ = KₖᵀKₖ`, `Kₖ[g][h] = δ_gh·βₖ[g] − νₖ[g]ᵀb_h` (the sample's scaled scores are `Kₖw`).
 struct Prepared {
+    /// `b_g = A⁻¹a_g`, per cluster.
+    b: Vec<DVector<f64>>,
     /// `βₖ`, `[k][g]`.
     beta: Vec<Vec<f64>>,
-    /// `Qₖ`, `[k][h][h']`.
+    /// `νₖ[g]`, `[k][g]`.
+    nu: Vec<Vec<DVector<f64>>>,
+    /// `Qₖ`, `[k][h][h']` (only when enumerating: G × G per contrast).
     q: Vec<Vec<Vec<f64>>>,
     /// CR1's small-sample factor `G/(G−1)·(n−1)/(n−p)`.
     c1: f64,
@@ -119,15 +124,19 @@ impl Prepared {
         }
     }
 
-    /// `t*_k` for every contrast at weights `w` (one per cluster), into `out`.
+    /// `t*_k` for every contrast at weights `w` (one per cluster), into `out`: O(G·p²).
     fn t_at(&self, w: &[f64], out: &mut [f64]) {
+        let mut d = DVector::<f64>::zeros(self.b.first().map_or(0, |b| b.len()));
+        for (wg, bg) in w.iter().zip(&self.b) {
+            d.axpy(*wg, bg, 1.0);
+        }
         for (k, o) in out.iter_mut().enumerate() {
-            let num: f64 = self.beta[k].iter().zip(w).map(|(a, b)| a * b).sum();
-            let quad: f64 = self.q[k]
-                .iter()
-                .zip(w)
-                .map(|(row, wh)| wh * row.iter().zip(w).map(|(a, b)| a * b).sum::<f64>())
-                .sum();
+            let (mut num, mut quad) = (0.0, 0.0);
+            for ((wg, bk), nu) in w.iter().zip(&self.beta[k]).zip(&self.nu[k]) {
+                num += wg * bk;
+                let e = wg * bk - nu.dot(&d);
+                quad += e * e;
+            }
             *o = self.t(num, quad);
         }
     }
@@ -168,29 +177,36 @@ fn wild_cluster_t_up_to(
         .map(|c| &ainv * DVector::from_column_slice(&c.score))
         .collect();
     let mut beta = Vec::with_capacity(contrasts.len());
-    let mut q = Vec::with_capacity(contrasts.len());
+    let mut nu = Vec::with_capacity(contrasts.len());
+    let mut q = Vec::new();
     for l in contrasts {
         let l = DVector::from_column_slice(l);
         let al = &ainv * &l;
         let bk: Vec<f64> = b.iter().map(|bg| l.dot(bg)).collect();
-        let kmat = DMatrix::from_fn(g, g, |r, h| {
-            let nu = DMatrix::from_row_slice(p, p, &clusters[r].xtx) * &al;
-            f64::from(u8::from(r == h)) * bk[r] - nu.dot(&b[h])
-        });
-        let qk = kmat.transpose() * kmat;
-        q.push(
-            (0..g)
-                .map(|h| qk.row(h).iter().copied().collect())
-                .collect(),
-        );
+        let nk: Vec<DVector<f64>> = clusters
+            .iter()
+            .map(|c| DMatrix::from_row_slice(p, p, &c.xtx) * &al)
+            .collect();
+        if g <= enumerate_max {
+            let kmat = DMatrix::from_fn(g, g, |r, h| {
+                f64::from(u8::from(r == h)) * bk[r] - nk[r].dot(&b[h])
+            });
+            let qk = kmat.transpose() * kmat;
+            q.push(
+                (0..g)
+                    .map(|h| qk.row(h).iter().copied().collect())
+                    .collect(),
+            );
+        }
         beta.push(bk);
+        nu.push(nk);
     }
     let c1 = g as f64 / (g - 1) as f64 * (n_obs - 1) as f64 / (n_obs - p) as f64;
     let se_cr1 = beta
         .iter()
         .map(|bk: &Vec<f64>| (c1 * bk.iter().map(|x| x * x).sum::<f64>()).sqrt())
         .collect();
-    let prep = Prepared { beta, q, c1 };
+    let prep = Prepared { b, beta, nu, q, c1 };
     let nk = contrasts.len();
     let Draws::EnumerateOr { n, seed } = draws;
     if g <= enumerate_max {
