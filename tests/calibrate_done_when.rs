@@ -46,6 +46,14 @@ fn stage(dir: &Path, which: &str) -> HashMap<(String, i64), (f64, f64)> {
     out
 }
 
+/// The (speed in cm/s, (measured, generated)) pairs of one quantity in a stage's residuals.
+fn quantity(r: &HashMap<(String, i64), (f64, f64)>, q: &str) -> Vec<(i64, (f64, f64))> {
+    r.iter()
+        .filter(|(k, _)| k.0 == q)
+        .map(|(k, v)| (k.1, *v))
+        .collect()
+}
+
 fn calibrate(input: &Path, out: &Path) {
     calibrate_with(input, out, &[]);
 }
@@ -99,11 +107,7 @@ fn schreiber_2014001_double_support() {
     let tmp = tempfile::tempdir().expect("temp dir");
     calibrate(&dir, tmp.path());
     let r = calibrated(tmp.path());
-    let ds: Vec<_> = r
-        .iter()
-        .filter(|(k, _)| k.0 == "double_support_pct_cycle")
-        .map(|(k, v)| (k.1, *v))
-        .collect();
+    let ds = quantity(&r, "double_support_pct_cycle");
     assert_eq!(ds.len(), 2, "C4 and C5: {r:?}");
     for (v, (m, g)) in ds {
         println!(
@@ -182,11 +186,7 @@ fn schreiber_2014004_2014007_double_support() {
         let tmp = tempfile::tempdir().expect("temp dir");
         calibrate(&dir, tmp.path());
         let r = calibrated(tmp.path());
-        let ds: Vec<_> = r
-            .iter()
-            .filter(|(k, _)| k.0 == "double_support_pct_cycle")
-            .map(|(k, v)| (k.1, *v))
-            .collect();
+        let ds = quantity(&r, "double_support_pct_cycle");
         assert_eq!(ds.len(), 2, "{subject}: two speeds: {r:?}");
         for (v, (m, g)) in ds {
             println!("{subject} {v} cm/s: double support {m:.2} → {g:.2} % cycle");

@@ -7,6 +7,12 @@
 //! Bell–McCaffrey degrees of freedom from GᵀG; the F set of k1 by fitting every admissible
 //! partition; the clustered standard error of a mean of subject slopes from the dense design).
 //! Regenerate with `/work/venv/bin/python tools/reference/inference.py` after `data/` changes.
+//!
+//! The wild cluster bootstrap-t (Webb six-point weights, unrestricted, every 6^G weight pattern
+//! enumerated) against `tools/reference/wild.json`, written by `tools/reference/wild.py` (numpy,
+//! all 6^10 and 6^9 patterns; its closed form checked against statsmodels refits of 200 random
+//! patterns). Both sides are exact (no Monte Carlo error), so they must agree to rounding.
+//! Regenerate with `/work/venv/bin/python tools/reference/wild.py` after `data/` changes.
 use gaitfit::export::coeffs::FitRecord;
 use gaitfit::fit::inference::SeMethod;
 use gaitfit::fit::pipeline::{fit_relation, load_tables, FitOptions};
@@ -440,5 +446,59 @@ fn random_intercept_reml_matches_statsmodels_mixedlm() {
             1e-9,
             &format!("{id} REML log-likelihood"),
         );
+    }
+}
+
+#[test]
+fn wild_cluster_bootstrap_matches_the_numpy_enumeration() {
+    let reference: Value = serde_json::from_str(
+        &std::fs::read_to_string(root().join("tools/reference/wild.json")).expect("wild.json"),
+    )
+    .expect("json");
+    let tables = bundled();
+    for id in ["walk-sl-sf", "walk-tds-sf"] {
+        let rel = by_id(id).expect("relation");
+        let opts = FitOptions {
+            bootstrap: 10,
+            ..FitOptions::default()
+        };
+        let r = fit_relation(rel.as_ref(), &tables, &opts)
+            .expect("fit")
+            .record;
+        let want = &reference[id];
+        let w = r.wild_bootstrap.as_ref().expect("wild bootstrap record");
+        assert!(w.enumerated, "{id}: every pattern enumerated");
+        assert_eq!(Some(w.samples), want["samples"].as_u64(), "{id}: 6^G");
+        assert_eq!(
+            w.coefficients.len(),
+            want["coefficients"]
+                .as_object()
+                .expect("coefficients")
+                .len()
+        );
+        for c in &w.coefficients {
+            let e = &want["coefficients"][&c.name];
+            close(
+                c.se_cr1,
+                num(&e["se_cr1"]),
+                1e-9,
+                &format!("{id} {} SE_CR1", c.name),
+            );
+            for j in 0..2 {
+                close(
+                    c.t_quantiles[j],
+                    num(&e["t_quantiles"][j]),
+                    1e-9,
+                    &format!("{id} {} t* quantile {j}", c.name),
+                );
+                let ci = c.ci95.expect("finite interval");
+                close(
+                    ci[j],
+                    num(&e["ci95_wild"][j]),
+                    1e-9,
+                    &format!("{id} {} interval end {j}", c.name),
+                );
+            }
+        }
     }
 }

@@ -1,5 +1,5 @@
 """Reference wild cluster bootstrap-t (Webb six-point weights, unrestricted) for
-`tests/reference_wild.rs`, and the CR2 / Bell–McCaffrey intervals it is compared with.
+`tests/reference_inference.rs` (wild_cluster_bootstrap_matches_the_numpy_enumeration), and the CR2 / Bell–McCaffrey intervals it is compared with.
 
 Data: the bundled trials tables `data/*.csv` (committed), read as gaitfit reads them
 (`common.py`). Relations: the two linear in every coefficient with no breakpoint, bound or
