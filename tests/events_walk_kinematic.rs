@@ -301,11 +301,13 @@ fn the_fraction_heel_strike_follows_walking_speed_and_the_tangent_stays_within_t
 #[ignore = "needs ../shared/data"]
 fn the_tangent_finds_a_heel_strike_the_record_end_cuts() {
     // Record ends: the BMClab walks cut 0.05 s after each plate heel strike past 0.5 s (the
-    // plates dropped, markers alone). A cut record that still holds one whole Zeni stance
-    // (the walking speed and the ground's velocity come from it) gives events; shorter ones
-    // give none with either rule (3 of the 6 cuts here), not scored. Measured: the tangent
-    // −3.0 ± 9.1 ms, 3 of 3 (the fraction rule −10.0 ± 12.1 ms, 3 of 3). Asserted: every
-    // scored cut heel strike found within the tolerance, mean within 15 ms, at least 3.
+    // plates dropped, markers alone). The walking speed comes from the pelvis over the
+    // ground; the ground's velocity from a whole Zeni stance in the record, or, with none
+    // (3 of the 6 cuts), 0 overground. Only a cut that leaves no landing to see gives no
+    // events (walk2 cut at 0.63 s), not scored. Measured: the tangent −6.8 ± 9.7 ms, 5 of 5
+    // (before the overground ground: −3.0 ± 9.1 ms on the 3 cuts that kept a stance, the two
+    // others gave no events). Asserted: every scored cut heel strike found within the
+    // tolerance, mean within 15 ms, at least 5.
     let b = require("bmclab");
     let plates: Vec<(String, GaitEvent)> = ["walk1", "walk2"]
         .iter()
@@ -353,5 +355,5 @@ fn the_tangent_finds_a_heel_strike_the_record_end_cuts() {
     }
     let mean = err_ms.iter().sum::<f64>() / err_ms.len() as f64;
     println!("cut record ends: {mean:+.1} ms mean, n {}", err_ms.len());
-    assert!(err_ms.len() >= 3 && mean.abs() <= 15.0, "{err_ms:?}");
+    assert!(err_ms.len() >= 5 && mean.abs() <= 15.0, "{err_ms:?}");
 }

@@ -763,7 +763,8 @@ impl Kinematics {
     /// ground moves as the toe marker does in mid-stance (25–65 % of each seed stance, when
     /// the forefoot is flat in walking), and the walking speed is the median forward velocity
     /// of the pelvis relative to it (the median ignores a start from standing or a stop).
-    /// `None` when no stance lies inside the record or the speed is not positive.
+    /// Without a seed stance inside the record the ground is taken at rest overground (0) and
+    /// is unknown on a treadmill (`None`); `None` too when the speed is not positive.
     pub fn ground_and_walking_speed(&self, seeds: &[GaitEvent]) -> Option<(f64, f64)> {
         let n = self.time_s.len();
         if n < 3 {
@@ -784,7 +785,13 @@ impl Kinematics {
             );
             ground.extend((a..=b).map(|i| self.fwd(&v[i])));
         }
-        let ground = median(&mut ground)?;
+        let ground = match median(&mut ground) {
+            Some(g) => g,
+            // No seed stance inside the record (a short overground record cut around one
+            // step): the ground of an overground lab is at rest.
+            None if self.setting == Setting::Overground => 0.0,
+            None => return None,
+        };
         let pv = self.velocity(&self.pelvis);
         let mut rel: Vec<f64> = pv.iter().map(|v| self.fwd(v) - ground).collect();
         let speed = median(&mut rel)?;
