@@ -316,9 +316,10 @@ pub fn calibrate_subject(
     rel: &Relations,
     opts: &CalibrateOptions,
 ) -> Result<SubjectResult, CalibrateError> {
+    let mut subject = subject;
     let model = model_of(&subject, opts);
     let init = model.initial(subject.body_height_m);
-    let (before, after, se, iters, evals) = {
+    let (before, after, se, iters, evals, note) = {
         let problem = Problem::new(&subject, model, rel, opts);
         let before = problem.stage(&init);
         let steps: Vec<f64> = model.params().iter().map(|d| d.step).collect();
@@ -336,6 +337,7 @@ pub fn calibrate_subject(
                     .configure(|s| s.param(u0.clone()).max_iters(opts.max_iters))
                     .run()
             });
+        let mut note = None;
         let (theta, iters) = match res {
             Ok(r) => {
                 let st = r.state();
@@ -343,12 +345,22 @@ pub fn calibrate_subject(
                 let p = DVector::from_iterator(u.len(), u.iter().zip(&steps).map(|(u, s)| u * s));
                 (problem.clamp(&p), st.get_iter())
             }
-            Err(_) => (init.clone(), 0),
+            Err(e) => {
+                note = Some(format!(
+                    "calibration: the trust-region solver failed ({e}); the relations' attributes are kept"
+                ));
+                (init.clone(), 0)
+            }
         };
         let mut after = problem.stage(&theta);
         let mut theta = theta;
         if after.cost > before.cost {
             // Gauss–Newton did not improve on the start (noisy objective): keep the start.
+            note = Some(format!(
+                "calibration: the best point found (objective {:.3}) is worse than the relations' \
+                 attributes ({:.3}); they are kept",
+                after.cost, before.cost
+            ));
             after = before.clone();
             theta = init;
         }
@@ -371,8 +383,10 @@ pub fn calibrate_subject(
             None => vec![None; p],
         };
         let evals = problem.evals.load(Ordering::Relaxed);
-        (before, after, se, iters, evals)
+        (before, after, se, iters, evals, note)
     };
+    // Said in the report and the summary, not only by an unchanged objective.
+    subject.notes.extend(note);
     Ok(SubjectResult {
         subject,
         model,

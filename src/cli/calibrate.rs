@@ -108,6 +108,16 @@ pub fn run(args: &Args) -> anyhow::Result<ExitCode> {
     for f in &cal.failed {
         eprintln!("gaitfit: warning: not measured: {f}");
     }
+    for r in &cal.subjects {
+        for n in r
+            .subject
+            .notes
+            .iter()
+            .filter(|n| n.starts_with("calibration:"))
+        {
+            eprintln!("gaitfit: warning: {}: {n}", r.subject.name);
+        }
+    }
     if let Some(l) = &cal.kb_leave_one_out {
         let (p, c, n) = (
             l.mean.generalized_same,
