@@ -381,7 +381,8 @@ pub struct SubjectResult {
     /// Standard errors of the calibrated parameters (Gauss–Newton covariance), in the order
     /// of [`drive::AttrModel::params`].
     pub se: Vec<Option<f64>>,
-    /// Gauss–Newton iterations and objective evaluations.
+    /// Trust-region iterations run (always `max_iters` unless the solver failed: argmin's
+    /// `TrustRegion` has no convergence test of its own).
     pub iterations: u64,
     /// Objective evaluations.
     pub evaluations: usize,

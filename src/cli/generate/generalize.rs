@@ -76,7 +76,8 @@ pub struct Options {
     /// Ko–Badler variant: `paper` (W's rigid drawing, eqs. 11–12, 25–48) or `carried` (the
     /// prototype's measured angle curves kept in W: the paper's feet, the hip placed where the
     /// drawn angles come nearest them; the prototype must carry measured angles — the bundled
-    /// one does).
+    /// one does). Default `paper`: the generator draws the published model; `gaitfit
+    /// calibrate`, which compares with measured subjects, defaults to `carried`.
     #[arg(
         long = "kb-variant",
         value_name = "paper|carried",
