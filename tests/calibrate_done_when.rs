@@ -98,6 +98,22 @@ fn hamner_run_3_calibrated() {
     let (_, knee) = get("knee_flexion_rms_deg");
     println!("knee RMS {knee:.1}°");
     assert!(knee.is_finite() && knee > 0.0, "knee RMS {knee}");
+    converged_before_the_cap(tmp.path());
+}
+
+/// The trust region stopped on a convergence test, before the default iteration cap (50).
+fn converged_before_the_cap(dir: &Path) {
+    let text = std::fs::read_to_string(dir.join("calibrated.json")).expect("calibrated.json");
+    let json: serde_json::Value = serde_json::from_str(&text).expect("json");
+    for s in json["subjects"].as_array().expect("subjects") {
+        let solver = &s["solver"];
+        println!("{}: {solver}", s["subject"]);
+        assert_eq!(solver["converged"], true, "{solver}");
+        assert!(
+            solver["iterations"].as_u64().expect("iterations") < 50,
+            "{solver}"
+        );
+    }
 }
 
 #[test]
@@ -116,6 +132,7 @@ fn schreiber_2014001_double_support() {
         );
         assert!((g - m).abs() < 1.0, "{v} cm/s: {g} vs {m} % cycle");
     }
+    converged_before_the_cap(tmp.path());
     let kb = stage(tmp.path(), "ko-badler");
     for q in ["step_length_m", "cadence_steps_per_min"] {
         let rows: Vec<_> = kb.iter().filter(|(k, _)| k.0 == q).collect();

@@ -116,6 +116,7 @@ fn generate_reuses_a_calibration_file() {
                 attr("flight_time_offset_s", "s", 0.0, slope.map(|_| 0.0)),
                 attr("bounciness_deg", "deg", 40.0, None),
             ],
+            solver: None,
         }],
     };
     let write = |name: &str, text: String| {

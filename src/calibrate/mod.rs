@@ -68,7 +68,8 @@ pub struct CalibrateOptions {
     pub gait: Option<Gait>,
     /// Generated motions.
     pub drive: DriveOptions,
-    /// Trust-region iterations at most.
+    /// Trust-region iterations at most (the cap; the solver stops earlier when a convergence
+    /// test of [`solve`] is met).
     pub max_iters: u64,
     /// The Ko–Badler variant of the `ko-badler` stage (the paper's drawing, or the subject's
     /// measured angle curves carried in W).
@@ -88,7 +89,7 @@ impl Default for CalibrateOptions {
             refit_dir: None,
             gait: None,
             drive: DriveOptions::default(),
-            max_iters: 8,
+            max_iters: 50,
             kb_variant: Variant::Carried,
             speed_slopes: false,
             leave_one_speed_out: false,
@@ -381,11 +382,9 @@ pub struct SubjectResult {
     /// Standard errors of the calibrated parameters (Gauss–Newton covariance), in the order
     /// of [`drive::AttrModel::params`].
     pub se: Vec<Option<f64>>,
-    /// Trust-region iterations run (always `max_iters` unless the solver failed: argmin's
-    /// `TrustRegion` has no convergence test of its own).
-    pub iterations: u64,
-    /// Objective evaluations.
-    pub evaluations: usize,
+    /// How the trust region stopped: the convergence test met, or the iteration cap, or a
+    /// failure; its iterations and objective evaluations ([`solve::Termination`]).
+    pub termination: solve::Termination,
     /// Stage `ko-badler` (walks with another condition of the subject): each condition
     /// generalized from the subject's walk at the nearest other speed ([`kb`]).
     pub kb: Option<solve::Stage>,
@@ -469,6 +468,10 @@ pub struct CalibratedSubject {
     pub reference_speed_m_per_s: Option<f64>,
     /// The attributes.
     pub attributes: Vec<CalibratedAttr>,
+    /// How the calibration's solver stopped (added to format 2 without a new tag: optional,
+    /// informational, ignored by readers; absent in files written before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub solver: Option<solve::Termination>,
 }
 
 /// One calibrated attribute.
@@ -619,7 +622,7 @@ pub fn summary_line(r: &SubjectResult) -> String {
     });
     format!(
         "{} ({}, {} condition(s), {:.2}–{:.2} m/s): |Δcadence| {:.1} → {:.1} steps/min, \
-         |Δstep length| {:.1} → {:.1} cm, |Δ{pname}| {:.1} → {:.1} {punit}{held}",
+         |Δstep length| {:.1} → {:.1} cm, |Δ{pname}| {:.1} → {:.1} {punit}{held}; {}",
         s.name,
         s.gait,
         s.conditions.len(),
@@ -631,5 +634,6 @@ pub fn summary_line(r: &SubjectResult) -> String {
         100.0 * mean_abs(&r.after, 1),
         pscale * mean_abs(&r.before, 3),
         pscale * mean_abs(&r.after, 3),
+        r.termination.describe(),
     )
 }

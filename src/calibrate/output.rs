@@ -177,6 +177,7 @@ pub fn calibrated_file(cal: &Calibration) -> CalibratedFile {
                         }
                     })
                     .collect(),
+                solver: Some(r.termination.clone()),
             })
             .collect(),
     }
@@ -341,8 +342,8 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
         let s = &r.subject;
         let _ = write!(
             h,
-            "<section><h2>{} — {}</h2><p>Body height {:.3} m{}; {} condition(s); objective {:.2} → {:.2} \
-             ({} trust-region iteration(s)).</p>",
+            "<section><h2>{} — {}</h2><p>Body height {:.3} m{}; {} condition(s); objective {:.2} → {:.2}; \
+             trust region {}{} ({} objective evaluations).</p>",
             esc(&s.name),
             s.gait,
             s.body_height_m,
@@ -354,7 +355,20 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
             s.conditions.len(),
             r.before.cost,
             r.after.cost,
-            r.iterations
+            if r.termination.converged {
+                ""
+            } else {
+                "<b>not converged</b>: "
+            },
+            esc(&if r.termination.converged {
+                r.termination.describe()
+            } else {
+                format!(
+                    "{} after {} iteration(s)",
+                    r.termination.reason, r.termination.iterations
+                )
+            }),
+            r.termination.evaluations
         );
         for n in &s.notes {
             let _ = write!(h, "<p class=\"note\">{}</p>", esc(n));

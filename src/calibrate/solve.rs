@@ -33,15 +33,72 @@
 //! from 38 to 550) and no iterate improved on the start, which was kept (2014007's double
 //! support −1.8 / −4.0 % of the cycle after "calibration"). The trust region accepts a step
 //! only when the objective falls, and shrinks it otherwise.
+//!
+//! Stopping: MINPACK's convergence tests, through the same argmin wrapper as
+//! [`crate::fit::nonlinear::nls`] (`fit::nonlinear::Stopping`): an accepted step that lowered
+//! the objective by at most [`FTOL`] relative (and the model predicted no more), a step or a
+//! trust radius below [`XTOL`] relative to the parameters, every Jacobian column within cosine
+//! [`GTOL`] of orthogonal to the residuals, or a zero residual. Otherwise the solver stops at
+//! `CalibrateOptions::max_iters`, and says so ([`Termination`]: "NOT converged: iteration cap
+//! (N) reached" in the summary line, report.html and calibrated.json). On a quantised
+//! objective the usual stop is the radius test: steps shorter than the objective's resolution
+//! are rejected until the radius falls below [`XTOL`].
 use super::drive::{self, AttrModel, Relations};
 use super::measure::Measurement;
 use super::{measure_generated, CalibrateError, CalibrateOptions, Subject, SubjectResult};
 use crate::events::Gait;
-use argmin::core::{CostFunction, Executor, Gradient, Hessian, State};
+use crate::fit::nonlinear::Stopping;
+use argmin::core::{CostFunction, Executor, Gradient, Hessian, State, TerminationReason};
 use argmin::solver::trustregion::{Steihaug, TrustRegion};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// MINPACK's `ftol` of the calibration: stop when an accepted step lowered the objective by at
+/// most this fraction and the Gauss–Newton model predicted no more. The objective is in units
+/// of the subject's step-to-step variability; a thousandth of it is far below what the
+/// generated motion resolves (its quantities move in whole frames).
+pub const FTOL: f64 = 1e-3;
+
+/// MINPACK's `xtol` of the calibration: stop when the step, or the trust radius after a
+/// rejected step, is below `XTOL·(‖u‖ + XTOL)`, `u` the parameters in finite-difference steps.
+/// ‖u‖ is 10–25 (bounciness or leg stiffness in steps of 2), so the test stops at ~0.01–0.03
+/// of a finite-difference step: 0.1–0.3 mm of step-length offset, ~0.1 ms of flight offset,
+/// far below one generated frame and below every attribute's standard error.
+pub const XTOL: f64 = 1e-3;
+
+/// MINPACK's `gtol` of the calibration: stop when every Jacobian column is within this cosine
+/// of orthogonal to the residual vector (a stationary point of the objective).
+pub const GTOL: f64 = 1e-3;
+
+/// How a subject's trust region stopped.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Termination {
+    /// A convergence test ([`FTOL`], [`XTOL`], [`GTOL`], zero residual, step below machine
+    /// precision) was met; `false`: the iteration cap was reached or the solver failed.
+    pub converged: bool,
+    /// Why it stopped, e.g. "relative reduction below ftol", "iteration cap (8) reached".
+    pub reason: String,
+    /// Trust-region iterations run (accepted and rejected steps).
+    pub iterations: u64,
+    /// Objective evaluations (each one generates and measures every condition of the subject).
+    pub evaluations: usize,
+}
+
+impl Termination {
+    /// "converged after 5 iteration(s): relative reduction below ftol", or "NOT converged: …".
+    pub fn describe(&self) -> String {
+        if self.converged {
+            format!(
+                "converged after {} iteration(s): {}",
+                self.iterations, self.reason
+            )
+        } else {
+            format!("NOT converged: {}", self.reason)
+        }
+    }
+}
 
 /// Residual given to a quantity the generated motion does not show, in units of σ.
 pub const MISSING_RESIDUAL: f64 = 10.0;
@@ -319,7 +376,7 @@ pub fn calibrate_subject(
     let mut subject = subject;
     let model = model_of(&subject, opts);
     let init = model.initial(subject.body_height_m);
-    let (before, after, se, iters, evals, note) = {
+    let (before, after, se, termination, note) = {
         let problem = Problem::new(&subject, model, rel, opts);
         let before = problem.stage(&init);
         let steps: Vec<f64> = model.params().iter().map(|d| d.step).collect();
@@ -332,24 +389,46 @@ pub fn calibrate_subject(
         let res = TrustRegion::new(Steihaug::new())
             .with_radius(TRUST_RADIUS.0)
             .and_then(|t| t.with_max_radius(TRUST_RADIUS.1))
-            .and_then(|solver| {
+            .and_then(|tr| {
+                let solver = Stopping::new(tr, XTOL, GTOL).with_ftol(FTOL);
                 Executor::new(scaled, solver)
                     .configure(|s| s.param(u0.clone()).max_iters(opts.max_iters))
+                    .timer(false)
                     .run()
             });
         let mut note = None;
-        let (theta, iters) = match res {
+        let (theta, termination) = match res {
             Ok(r) => {
                 let st = r.state();
                 let u = st.get_best_param().cloned().unwrap_or(u0);
                 let p = DVector::from_iterator(u.len(), u.iter().zip(&steps).map(|(u, s)| u * s));
-                (problem.clamp(&p), st.get_iter())
+                let (converged, reason) = match st.get_termination_reason() {
+                    Some(TerminationReason::SolverExit(why)) => (true, why.clone()),
+                    Some(TerminationReason::MaxItersReached) => {
+                        (false, format!("iteration cap ({}) reached", opts.max_iters))
+                    }
+                    Some(other) => (false, other.text().to_string()),
+                    None => (false, "the solver stopped without a reason".into()),
+                };
+                let t = Termination {
+                    converged,
+                    reason,
+                    iterations: st.get_iter(),
+                    evaluations: 0,
+                };
+                (problem.clamp(&p), t)
             }
             Err(e) => {
                 note = Some(format!(
                     "calibration: the trust-region solver failed ({e}); the relations' attributes are kept"
                 ));
-                (init.clone(), 0)
+                let t = Termination {
+                    converged: false,
+                    reason: format!("the solver failed: {e}"),
+                    iterations: 0,
+                    evaluations: 0,
+                };
+                (init.clone(), t)
             }
         };
         let mut after = problem.stage(&theta);
@@ -382,8 +461,9 @@ pub fn calibrate_subject(
                 .collect(),
             None => vec![None; p],
         };
-        let evals = problem.evals.load(Ordering::Relaxed);
-        (before, after, se, iters, evals, note)
+        let mut termination = termination;
+        termination.evaluations = problem.evals.load(Ordering::Relaxed);
+        (before, after, se, termination, note)
     };
     // Said in the report and the summary, not only by an unchanged objective.
     subject.notes.extend(note);
@@ -393,8 +473,7 @@ pub fn calibrate_subject(
         before,
         after,
         se,
-        iterations: iters,
-        evaluations: evals,
+        termination,
         kb: None,
         held_out: None,
     })

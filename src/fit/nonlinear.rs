@@ -490,18 +490,51 @@ impl<M: Model> Hessian for Adapter<'_, M> {
     }
 }
 
-type TrState = IterState<DVector<f64>, DVector<f64>, (), DMatrix<f64>, (), f64>;
+/// The argmin state of a trust region on `DVector` parameters with a `DMatrix` Hessian.
+pub(crate) type TrState = IterState<DVector<f64>, DVector<f64>, (), DMatrix<f64>, (), f64>;
 
 /// Wraps an argmin trust-region solver and adds MINPACK-style stopping tests (argmin's
-/// `TrustRegion` has none of its own).
-struct Stopping<S> {
+/// `TrustRegion` has none of its own). Also used by [`crate::calibrate`]'s trust region
+/// (with the `ftol` test, which [`nls`] does not use).
+pub(crate) struct Stopping<S> {
     inner: S,
     xtol: f64,
     gtol: f64,
+    /// MINPACK's `ftol` (relative reduction of the sum of squares), tested on accepted steps.
+    ftol: Option<f64>,
     accepted: u64,
     status: Option<String>,
     /// Trust radius of the previous iteration if its step was rejected.
     last_rejected_radius: Option<f64>,
+}
+
+impl<S> Stopping<S> {
+    /// `inner` with MINPACK's `xtol` and `gtol` tests (and the zero-residual and
+    /// machine-precision stops); no `ftol` test.
+    pub(crate) fn new(inner: S, xtol: f64, gtol: f64) -> Self {
+        Stopping {
+            inner,
+            xtol,
+            gtol,
+            ftol: None,
+            accepted: 0,
+            status: None,
+            last_rejected_radius: None,
+        }
+    }
+
+    /// Adds MINPACK's `ftol` test on every accepted step: the actual and the predicted
+    /// (Gauss–Newton model) relative reductions of the objective both at most `ftol`, and the
+    /// actual at most twice the predicted.
+    pub(crate) fn with_ftol(mut self, ftol: f64) -> Self {
+        self.ftol = Some(ftol);
+        self
+    }
+
+    /// Steps accepted so far.
+    pub(crate) fn accepted(&self) -> u64 {
+        self.accepted
+    }
 }
 
 fn vnorm(v: &DVector<f64>) -> f64 {
@@ -528,13 +561,34 @@ where
         state: TrState,
     ) -> Result<(TrState, Option<KV>), argmin::core::Error> {
         let before = state.get_param().cloned();
+        // The Gauss–Newton model at the current point, for the ftol test's predicted reduction.
+        let model = self.ftol.and_then(|_| {
+            Some((
+                state.get_cost(),
+                state.get_gradient()?.clone(),
+                state.get_hessian()?.clone(),
+            ))
+        });
         let (state, kv) = self.inner.next_iter(problem, state)?;
         if let (Some(b), Some(a)) = (before, state.get_param()) {
             let scale = self.xtol * (vnorm(a) + self.xtol);
             if *a != b {
                 self.accepted += 1;
-                if vnorm(&(a - &b)) <= scale {
+                let step = a - &b;
+                if vnorm(&step) <= scale {
                     self.status = Some("relative step below xtol".into());
+                }
+                if let (Some(ftol), Some((f0, g, h))) = (self.ftol, model) {
+                    let predicted = -(step.dot(&g) + 0.5 * step.dot(&(&h * &step)));
+                    let actual = f0 - state.get_cost();
+                    if f0 > 0.0
+                        && actual.abs() <= ftol * f0
+                        && predicted <= ftol * f0
+                        && actual <= 2.0 * predicted
+                    {
+                        self.status
+                            .get_or_insert_with(|| "relative reduction below ftol".into());
+                    }
                 }
                 self.last_rejected_radius = None;
             } else if let Some(KvValue::Float(radius)) = kv.as_ref().and_then(|k| k.get("radius")) {
@@ -803,14 +857,7 @@ pub fn nls<M: Model>(
                 relation: name.clone(),
                 message: e.to_string(),
             })?;
-        let solver = Stopping {
-            inner: tr,
-            xtol: opts.xtol,
-            gtol: opts.gtol,
-            accepted: 0,
-            status: None,
-            last_rejected_radius: None,
-        };
+        let solver = Stopping::new(tr, opts.xtol, opts.gtol);
         let budget = opts.max_iter - iterations;
         let mut res = Executor::new(probe, solver)
             .configure(|s| s.param(v0).max_iters(budget))
@@ -829,7 +876,7 @@ pub fn nls<M: Model>(
                 other => other.text().to_string(),
             })
             .unwrap_or_else(|| "unknown".into());
-        let accepted = res.solver().accepted;
+        let accepted = res.solver().accepted();
         let v = state
             .get_best_param()
             .or_else(|| state.get_param())
