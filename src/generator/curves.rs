@@ -1,5 +1,6 @@
 //! Interpolation primitives shared by the generators, evaluated every frame: cubic Hermite
-//! segments (scalar and 3-D), the C² middle-knot velocity and the smoothstep blend. No allocation.
+//! segments (scalar and 3-D), the quintic Hermite segment, the C² middle-knot velocity and the
+//! smoothstep blends. No allocation.
 use glam::DVec3;
 
 /// Value and derivative of the cubic Hermite segment through `(t0, p0, m0)` and `(t1, p1, m1)`
@@ -104,9 +105,76 @@ pub fn smootherstep(s: f64) -> f64 {
     s * s * s * (s * (6.0 * s - 15.0) + 10.0)
 }
 
+/// The quintic Hermite segment on `[0, d]` from `(p0, v0, a0)` to `(p1, v1, a1)` (value, rate,
+/// acceleration at each end): the C² interpolant of KLAW's recorded tracks and the stop's
+/// curves. Constant beyond `d` when read by time ([`Quintic::at`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Quintic {
+    c: [f64; 6],
+    d: f64,
+}
+
+impl Quintic {
+    /// The quintic with the given end values, rates and accelerations over `d > 0` s.
+    pub fn new(start: [f64; 3], end: [f64; 3], d: f64) -> Quintic {
+        let [p0, v0, a0] = start;
+        let [p1, v1, a1] = end;
+        // In s = t/d: q(s) = Σ c_i s^i with q'(s) = v·d and q''(s) = a·d².
+        let c1 = d * v0;
+        let c2 = 0.5 * d * d * a0;
+        let p = p1 - p0 - c1 - c2;
+        let v = d * v1 - c1 - 2.0 * c2;
+        let acc = d * d * a1 - 2.0 * c2;
+        let c3 = 10.0 * p - 4.0 * v + 0.5 * acc;
+        let c4 = -15.0 * p + 7.0 * v - acc;
+        let c5 = 6.0 * p - 3.0 * v + 0.5 * acc;
+        Quintic {
+            c: [p0, c1, c2, c3, c4, c5],
+            d,
+        }
+    }
+
+    /// Value, rate and acceleration at `t` s (clamped to `[0, d]`; rates 0 from `d` on).
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        let r = self.at_fraction((t / self.d).clamp(0.0, 1.0));
+        if t >= self.d {
+            return [r[0], 0.0, 0.0];
+        }
+        r
+    }
+
+    /// Value, rate and acceleration (per second) at the fraction `s = t/d` of the segment.
+    pub fn at_fraction(&self, s: f64) -> [f64; 3] {
+        let c = &self.c;
+        let p = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * (c[4] + s * c[5]))));
+        let v = c[1] + s * (2.0 * c[2] + s * (3.0 * c[3] + s * (4.0 * c[4] + s * 5.0 * c[5])));
+        let a = 2.0 * c[2] + s * (6.0 * c[3] + s * (12.0 * c[4] + s * 20.0 * c[5]));
+        [p, v / self.d, a / (self.d * self.d)]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quintic_meets_its_end_conditions() {
+        let q = Quintic::new([0.3, 1.2, -0.7], [1.0, 0.0, 0.0], 0.8);
+        let a = q.at(0.0);
+        assert!((a[0] - 0.3).abs() < 1e-12 && (a[1] - 1.2).abs() < 1e-12);
+        assert!((a[2] + 0.7).abs() < 1e-9);
+        let b = q.at(0.8 - 1e-12);
+        assert!((b[0] - 1.0).abs() < 1e-9 && b[1].abs() < 1e-9 && b[2].abs() < 1e-6);
+        // Rates are the derivatives of the positions.
+        for k in 1..20 {
+            let t = 0.04 * k as f64;
+            let e = 1e-6;
+            let (p, m) = (q.at(t + e), q.at(t - e));
+            let c = q.at(t);
+            assert!((c[1] - (p[0] - m[0]) / (2.0 * e)).abs() < 1e-6);
+            assert!((c[2] - (p[1] - m[1]) / (2.0 * e)).abs() < 1e-5);
+        }
+    }
 
     #[test]
     fn hermite_acc_is_the_derivative_of_the_rate() {

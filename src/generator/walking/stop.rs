@@ -21,7 +21,7 @@ use super::foot::FootShape;
 use super::track::interp_rho;
 use super::virtual_leg::{FootPeriod, LegPose, VirtualLeg};
 use crate::events::Side;
-use crate::generator::curves::smootherstep;
+use crate::generator::curves::{smootherstep, Quintic};
 
 /// Knee slack of the standing legs.
 pub const STAND_KNEE_SLACK: f64 = 0.001;
@@ -33,46 +33,6 @@ pub const STAND_HIP_AHEAD: f64 = 0.03;
 /// Extra lift of the trailing ankle at mid-swing over the toe clearance, m (the foot is brought
 /// alongside, not stepped over an obstacle).
 const SWING_LIFT: f64 = 0.02;
-
-/// A quintic `p(t)` on `[0, d]` from `(p0, v0, a0)` to `(p1, v1, a1)`; constant beyond `d`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quintic {
-    c: [f64; 6],
-    d: f64,
-}
-
-impl Quintic {
-    /// The quintic with the given end values, rates and accelerations over `d > 0` s.
-    pub fn new(start: [f64; 3], end: [f64; 3], d: f64) -> Quintic {
-        let [p0, v0, a0] = start;
-        let [p1, v1, a1] = end;
-        // In s = t/d: q(s) = Σ c_i s^i with q'(s) = v·d and q''(s) = a·d².
-        let (v0, a0, v1, a1) = (v0 * d, a0 * d * d, v1 * d, a1 * d * d);
-        let h = p1 - p0 - v0 - 0.5 * a0;
-        let hv = v1 - v0 - a0;
-        let ha = a1 - a0;
-        let c3 = 10.0 * h - 4.0 * hv + 0.5 * ha;
-        let c4 = -15.0 * h + 7.0 * hv - ha;
-        let c5 = 6.0 * h - 3.0 * hv + 0.5 * ha;
-        Quintic {
-            c: [p0, v0, 0.5 * a0, c3, c4, c5],
-            d,
-        }
-    }
-
-    /// Position, rate and acceleration at `t`.
-    pub fn at(&self, t: f64) -> [f64; 3] {
-        let s = (t / self.d).clamp(0.0, 1.0);
-        let c = &self.c;
-        let p = c[0] + s * (c[1] + s * (c[2] + s * (c[3] + s * (c[4] + s * c[5]))));
-        if t >= self.d {
-            return [p, 0.0, 0.0];
-        }
-        let v = c[1] + s * (2.0 * c[2] + s * (3.0 * c[3] + s * (4.0 * c[4] + s * 5.0 * c[5])));
-        let a = 2.0 * c[2] + s * (6.0 * c[3] + s * (12.0 * c[4] + s * 20.0 * c[5]));
-        [p, v / self.d, a / (self.d * self.d)]
-    }
-}
 
 /// The trunk and pelvis state at the last heel strike (pre-impact, as drawn), and the geometry
 /// of the stop.
@@ -423,30 +383,6 @@ impl Closing {
             stance_foot,
             trail_foot,
             trail_contact,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn quintic_meets_its_end_conditions() {
-        let q = Quintic::new([0.3, 1.2, -0.7], [1.0, 0.0, 0.0], 0.8);
-        let a = q.at(0.0);
-        assert!((a[0] - 0.3).abs() < 1e-12 && (a[1] - 1.2).abs() < 1e-12);
-        assert!((a[2] + 0.7).abs() < 1e-9);
-        let b = q.at(0.8 - 1e-12);
-        assert!((b[0] - 1.0).abs() < 1e-9 && b[1].abs() < 1e-9 && b[2].abs() < 1e-6);
-        // Rates are the derivatives of the positions.
-        for k in 1..20 {
-            let t = 0.04 * k as f64;
-            let e = 1e-6;
-            let (p, m) = (q.at(t + e), q.at(t - e));
-            let c = q.at(t);
-            assert!((c[1] - (p[0] - m[0]) / (2.0 * e)).abs() < 1e-6);
-            assert!((c[2] - (p[1] - m[1]) / (2.0 * e)).abs() < 1e-5);
         }
     }
 }

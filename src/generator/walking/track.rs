@@ -1,6 +1,7 @@
 //! Recorded trajectories of a phase: nodes `(t, q, q̇, q̈)` and quintic Hermite interpolation
 //! between them (exact in position, velocity and acceleration at the nodes), so the swing
 //! simulation can read the stance hip's acceleration at any instant.
+use crate::generator::curves::Quintic;
 
 /// One recorded node.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,18 +79,8 @@ impl<const N: usize> Track<N> {
         let mut qd = [0.0; N];
         let mut qdd = [0.0; N];
         for i in 0..N {
-            let c0 = a.q[i];
-            let c1 = h * a.qd[i];
-            let c2 = 0.5 * h * h * a.qdd[i];
-            let p = b.q[i] - c0 - c1 - c2;
-            let v = h * b.qd[i] - c1 - 2.0 * c2;
-            let acc = h * h * b.qdd[i] - 2.0 * c2;
-            let c3 = 10.0 * p - 4.0 * v + 0.5 * acc;
-            let c4 = -15.0 * p + 7.0 * v - acc;
-            let c5 = 6.0 * p - 3.0 * v + 0.5 * acc;
-            q[i] = c0 + s * (c1 + s * (c2 + s * (c3 + s * (c4 + s * c5))));
-            qd[i] = (c1 + s * (2.0 * c2 + s * (3.0 * c3 + s * (4.0 * c4 + s * 5.0 * c5)))) / h;
-            qdd[i] = (2.0 * c2 + s * (6.0 * c3 + s * (12.0 * c4 + s * 20.0 * c5))) / (h * h);
+            let seg = Quintic::new([a.q[i], a.qd[i], a.qdd[i]], [b.q[i], b.qd[i], b.qdd[i]], h);
+            [q[i], qd[i], qdd[i]] = seg.at_fraction(s);
         }
         (q, qd, qdd)
     }
