@@ -24,14 +24,23 @@
 //!   gives the same fit. It is minimised **exactly** over those partitions by branch and bound:
 //!   fitting the rows of a key range's complement gives a lower bound for every partition inside
 //!   the range (fewer rows never fit worse), so ranges whose bound exceeds the best partition
-//!   found are discarded and the rest bisected. The estimate is the midpoint of the optimal gap,
-//!   and its interval ends are data keys (where the partition changes).
-//! - Two breakpoints are profiled by coordinate descent.
+//!   found are discarded and the rest bisected. The first incumbent is the partition holding the
+//!   breakpoint's current value (a fold's or a replicate's: the whole data's estimate, usually
+//!   optimal or nearly so), so most ranges are discarded at their first bound; the start only
+//!   changes how much is pruned, never which partition is optimal (every range not discarded by
+//!   a valid bound is searched). The estimate is the midpoint of the optimal gap, and its
+//!   interval ends are data keys (where the partition changes).
+//! - Two breakpoints are profiled by coordinate descent; a breakpoint whose search would see the
+//!   same other coordinates (bit for bit) as its previous search keeps that search's value (the
+//!   search is a function of them: its result would be the same number).
+//!
+//! The partitions' search is exact to the rounding of the residual sums of squares: a
+//! partition better than the incumbent by less than 1e-12 of it is not distinguishable, and
+//! which of two such near-ties is reported may depend on the visit order.
 use super::Prepared;
 use crate::fit::design::{solve_rows, Layout};
 use crate::fit::forms::{DistinctKeys, Fitting};
 use crate::fit::nonlinear::minimize_1d;
-use crate::fit::prec::MIN1D_GRID;
 use crate::fit::record::BreakpointRecord;
 use crate::fit::FitError;
 use crate::relations::{Observation, ParamKind, Relation};
@@ -178,7 +187,8 @@ impl Discrete<'_> {
         (j0 <= j1 && j1 < self.keys.len()).then_some((j0, j1))
     }
 
-    /// The exact minimum over the partitions in `[lo, hi]` (branch and bound), as a value.
+    /// The exact minimum over the partitions in `[lo, hi]` (branch and bound from the whole
+    /// range, the partition holding `p[i]` the first incumbent), as a value.
     fn minimise(&self, p: &[f64], lo: f64, hi: f64, notes: &mut Vec<String>) -> Option<f64> {
         let (j0, j1) = self.candidates(lo, hi)?;
         let mut evals = 0usize;
@@ -191,12 +201,9 @@ impl Discrete<'_> {
                 *best = (r, j);
             }
         };
-        let cells = MIN1D_GRID.min(j1 - j0).max(1);
-        let mut grid: Vec<usize> = (0..=cells).map(|c| j0 + (j1 - j0) * c / cells).collect();
-        grid.dedup();
-        for &j in &grid {
-            visit(j, &mut best, &mut evals);
-        }
+        // Partition j holds the values in (keys[j − 1], keys[j]]: the number of keys below.
+        let warm = self.keys.partition_point(|&d| d < p[self.i]).clamp(j0, j1);
+        visit(warm, &mut best, &mut evals);
         let mut heap: BinaryHeap<Reverse<(Ordered, usize, usize)>> = BinaryHeap::new();
         let push = |a: usize,
                     b: usize,
@@ -210,11 +217,7 @@ impl Discrete<'_> {
                 heap.push(Reverse((Ordered(self.lower_bound(p, a, b)), a, b)));
             }
         };
-        for w in grid.windows(2) {
-            if w[1] > w[0] + 1 {
-                push(w[0] + 1, w[1] - 1, &mut heap, &mut best, &mut evals);
-            }
-        }
+        push(j0, j1, &mut heap, &mut best, &mut evals);
         while let Some(Reverse((Ordered(bound), a, b))) = heap.pop() {
             // Bounds agree with fits to rounding; a partition better than the best by less than
             // that is not distinguishable.
@@ -315,25 +318,40 @@ pub(super) fn profile(
         .collect();
     let mut p = p0.to_vec();
     let max_rounds = if bps.len() > 1 { 4 } else { 1 };
+    // Per breakpoint: the parameters its last search saw, and its result.
+    let mut last: Vec<Option<(Vec<f64>, f64)>> = vec![None; bps.len()];
+    let same_but = |i: usize, a: &[f64], b: &[f64]| {
+        a.iter()
+            .zip(b)
+            .enumerate()
+            .all(|(j, (x, y))| j == i || x.to_bits() == y.to_bits())
+    };
     for _ in 0..max_rounds {
         let mut moved = 0.0f64;
-        for &i in &bps {
+        for (slot, &i) in last.iter_mut().zip(&bps) {
             let Some((lo, hi)) = search[i] else { continue };
-            let t = match pr.discrete(i) {
-                Some(d) => d
-                    .minimise(&p, lo, hi, notes)
-                    .ok_or_else(|| FitError::Optimizer {
-                        relation: rel.card().id.into(),
-                        message: format!(
-                            "no partition of the rows by {} in [{lo}, {hi}] can be fitted",
-                            rel.card().parameters[i].name
-                        ),
-                    })?,
-                None => {
-                    let tol = (hi - lo).abs() * 1e-7;
-                    minimize_1d(|t| pr.rss_at(&p, i, t), lo, hi, tol)?.0
-                }
+            let t = match slot {
+                // The same search as last time (it does not read p[i] but for the discrete
+                // search's first incumbent, which does not change its optimum): its value.
+                Some((q, t)) if same_but(i, q, &p) => *t,
+                _ => match pr.discrete(i) {
+                    Some(d) => {
+                        d.minimise(&p, lo, hi, notes)
+                            .ok_or_else(|| FitError::Optimizer {
+                                relation: rel.card().id.into(),
+                                message: format!(
+                                    "no partition of the rows by {} in [{lo}, {hi}] can be fitted",
+                                    rel.card().parameters[i].name
+                                ),
+                            })?
+                    }
+                    None => {
+                        let tol = (hi - lo).abs() * 1e-7;
+                        minimize_1d(|t| pr.rss_at(&p, i, t), lo, hi, tol)?.0
+                    }
+                },
             };
+            *slot = Some((p.clone(), t));
             moved = moved.max((t - p[i]).abs() / (hi - lo).abs().max(f64::MIN_POSITIVE));
             p[i] = t;
         }
@@ -672,4 +690,101 @@ pub(super) fn refit(
     let p = profile(&pr, p_start, &search, &mut Vec::new()).ok()?;
     let (coef, _) = pr.solve(&p)?;
     Some(lay.params(rel, &p, &coef))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::forms::Fitting;
+    use crate::relations::{Inputs, RunTflightSf};
+
+    /// Flight times on a line with two jumps the free pieces cannot follow inside a piece: a small one at sf = 170 and a large one at sf = 196, so the profile of
+    /// k1 has a local minimum at the small jump and its global minimum at the large one.
+    fn two_jumps() -> Prepared {
+        let mut prep = Prepared::default();
+        let n = 420;
+        for i in 0..n {
+            let sf = 150.0 + 85.0 * i as f64 / n as f64 + 0.013 * ((i * 37) % 11) as f64;
+            let jumps =
+                if sf >= 170.0 { 0.006 } else { 0.0 } + if sf >= 196.0 { 0.02 } else { 0.0 };
+            let noise = 2e-4 * (((i * 7919) % 17) as f64 / 8.0 - 1.0);
+            prep.obs.push(Observation {
+                x: Inputs::new(&[sf]),
+                y: 0.1 - 4e-4 * (sf - 190.0) + jumps + noise,
+            });
+            prep.subject.push(i % 3);
+            prep.weights.push(1.0);
+        }
+        prep.subjects = (0..3).map(|s| format!("s{s}")).collect();
+        prep
+    }
+
+    #[test]
+    fn the_warm_started_partition_search_finds_the_global_minimum_from_a_local_one() {
+        let published = RunTflightSf::published();
+        let rel: &dyn Relation = &published;
+        let prep = two_jumps();
+        let form = rel.sorted_profile().expect("sorted form");
+        let sr = SortedRows::new(form, &prep, true);
+        let keys = sr.distinct_keys(&[true; 3]);
+        // k2 held beyond the data (no plateau): only k1 is searched.
+        let mut free = vec![true; 9];
+        free[8] = false;
+        let lay = Layout::new(rel, free, 3);
+        let pr = Profiler {
+            rel,
+            lay: &lay,
+            src: Source::Sorted {
+                sr: &sr,
+                members: Members::All,
+                keys: DistinctKeys::new(&keys),
+            },
+        };
+        let d = pr.discrete(7).expect("k1 is discrete");
+        let mut p = published.coefficients().to_vec();
+        p[8] = 250.0;
+        let (lo, hi) = (keys[4], keys[keys.len() - 5]);
+        let (j0, j1) = d.candidates(lo, hi).expect("partitions");
+        // Every partition's residual sum of squares.
+        let rss: Vec<f64> = (j0..=j1).map(|j| d.rss(&p, j)).collect();
+        let global = j0
+            + (0..rss.len())
+                .min_by(|&a, &b| rss[a].total_cmp(&rss[b]))
+                .expect("some");
+        assert!(
+            (d.value(global) - 196.0).abs() < 0.5,
+            "global minimum at {}",
+            d.value(global)
+        );
+        // A naive warm start (descend to the better neighbour while there is one) from the
+        // partition at the small jump stops there: a local minimum, not the global one.
+        let mut j = d.keys.partition_point(|&k| k < 170.0);
+        loop {
+            let r = |j: usize| rss[j - j0];
+            let next = [j.saturating_sub(1).max(j0), (j + 1).min(j1)]
+                .into_iter()
+                .filter(|&k| r(k) < r(j))
+                .min_by(|&a, &b| r(a).total_cmp(&r(b)));
+            match next {
+                Some(k) => j = k,
+                None => break,
+            }
+        }
+        assert!(
+            (d.value(j) - 170.0).abs() < 0.5,
+            "naive descent stops at {}",
+            d.value(j)
+        );
+        assert!(rss[j - j0] > rss[global - j0] * (1.0 + 1e-6));
+        // The branch and bound, warm-started at the local minimum (or anywhere else), finds the
+        // global one.
+        for start in [170.0, d.value(j0), d.value(j1), 196.0, 183.3, f64::NAN] {
+            let mut q = p.clone();
+            q[7] = start;
+            let mut notes = Vec::new();
+            let t = d.minimise(&q, lo, hi, &mut notes).expect("a partition");
+            assert_eq!(t.to_bits(), d.value(global).to_bits(), "start {start}");
+            assert!(notes.is_empty());
+        }
+    }
 }
