@@ -213,11 +213,8 @@ attributes! {
     /// Largest change of walking speed from one step to the next, m/s per step. A schedule's
     /// larger change between stretches is spread over as many steps as it needs, at equal
     /// increments of speed (`generate_walk`). Default 0.5: within what people do
-    /// (walking accelerations ≲ 0.5–1 m/s², ≈ 0.3–0.6 m/s per step) and below the largest
-    /// one-step change the generator handles about as well as steady walking (0.83 m/s, e.g.
-    /// 2 → 5 km/h; 1.11 m/s, 1 → 5 or 3 → 7 km/h, breaks the continuity check); of 0.4, 0.5, 0.6
-    /// and 0.85 it left the fewest of 126 schedule changes (1–7 km/h, 1.5/1.8/2.0 m) above a
-    /// continuity ratio of 10. 10 turns the ramps off (the paper's one-step changes, §2.4).
+    /// (walking accelerations ≲ 0.5–1 m/s², ≈ 0.3–0.6 m/s per step; measured: docs/klaw.md).
+    /// 10 turns the ramps off (the paper's one-step changes, §2.4).
     max_speed_change_m_per_s: 0.5, [0.05, 10.0], "m/s";
     /// Largest integration step (the stability bound may make it smaller). 4 ms: the shooting
     /// absorbs the integration error into the forces, which then differ by at most 0.2 % from a

@@ -15,16 +15,8 @@
 //! are continuous across the impact. So the new leg's initial `ẇ⁺` (the hip closing on the new
 //! ankle) is the old stance's hip velocity along the new leg. For a symmetric landing
 //! (`θ1 = ±a`) it is `ẇ⁺ = ẇ cos 2a − w θ̇1 sin 2a` (tested below). The collision carries the
-//! approach; it does not create it. Measured at 7 km/h × 1.5 m (Froude `v²/(g·l1)` 0.53, at the
-//! human walk–run transition; `2a` = 67°): `ẇ` 1.34 m/s, `w θ̇1` 2.50 m/s, so `ẇ⁺` = −1.77 m/s.
-//! The drawn hip closes on the heel at 13 mm/frame in the first frame after contact, against
-//! 2 mm/frame in the frame before. A rate that started near zero would need `ẇ ≈ 5.9` m/s or
-//! `θ̇1 ≈ 0.75` rad/s at heel strike, neither of which a walk meeting eq. 3 has. The other way to
-//! get it is an impulse along the new leg (a rigid or partly plastic landing), which kinks the
-//! hip's path. Measured, keeping 80 % of `ẇ⁺`: the hip's vertical velocity jumps from −0.26 to
-//! +0.08 m/s at the impact (0.44 m/s between two drawn frames). The 1 km/h walks and the
-//! 2 → 5 → 3 km/h × 2.0 m schedule then fail (continuity 9.6–11.3), so the telescopic collision
-//! is kept.
+//! approach; it does not create it (measured, and why a rigid or partly plastic landing is not
+//! used — it kinks the hip's path: docs/klaw.md).
 use super::body::Body;
 use super::dynamics::{solve3, StanceModel};
 use super::stance::StanceStart;

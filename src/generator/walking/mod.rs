@@ -21,18 +21,10 @@
 //!
 //! **Continuity caveat.** Steady walks of 1–7 km/h × 1.5–2.0 m meet the smoothness check
 //! [`crate::generator::checks::continuity`] at k = 5 (every frame-to-frame step within 5 × the
-//! median of its neighbours), except near the walk–run transition: 7 km/h × 1.5 m 5.04 steady
-//! (the ankle at a heel strike, frame 306; 5.45 before the drawn pelvis height was smoothed,
-//! [`pelvis_drop`]), 5.29 from standing with a stop, and on a 0.1 km/h ×
-//! 5 cm grid 6.7–7.0 km/h × 1.5–1.6 m (5.04–5.29 on main 40536a7) and 3.3 km/h × 1.55 m (5.02,
-//! the landing knee); 8 steps, 100 frames/s (`tests/klaw_continuity.rs`; 5.45 since the stance
-//! simulation locks at the paper's `l1` and the drawing lowers the pelvis instead,
-//! `draw::PelvisDrop`, docs/klaw.md). The landing
-//! knee, locked straight in swing3 as in the paper, starts flexing at 2–3 × its mean rate at
-//! heel strike. 7 km/h × 1.5 m is *above the walk–run transition*: its Froude number
-//! `v²/(g·l1)` is 0.53 > [`high_level::WALK_RUN_FROUDE`] (eq. 1 gives it a step of 1.16 × the
-//! leg, an inter-leg angle of 67° at heel strike), a speed at which a person of that height
-//! runs; its report carries a note saying so ([`high_level::walk_run_note`]).
+//! median of its neighbours) except near the walk–run transition (7 km/h × 1.5 m, the ankle at
+//! a heel strike), a speed above it: its Froude number `v²/(g·l1)` is 0.53 >
+//! [`high_level::WALK_RUN_FROUDE`] and its report carries a note saying so
+//! ([`high_level::walk_run_note`]). The figures and their history are in docs/klaw.md.
 //!
 //! The equations of motion are checked against an independent Lagrangian derivation
 //! ([`lagrange`]); the corrections to the printed equations are listed in [`dynamics`]. The
@@ -188,13 +180,7 @@ pub fn generate_walk(
     }
     // From standing the first step keeps its full length: with the feet side by side its swing
     // foot travels one step length (half a stride, as a person's first step does) and eq. 3's
-    // symmetric heel strike puts the hip half a step ahead. It used to be a half step (the swing
-    // foot travelling a quarter stride): its heel-strike thigh angle (≈ 7° at 2 km/h) was less
-    // than the standing swing leg's own, so swing1 could not move the ankle forward (1 mm at
-    // 2 km/h), swing2 threw the foot 19 cm past its landing and swing3 pulled it back (swing
-    // ankle peak/mean speed 4.4–14.6), at 1 km/h the toe-clearance pitch sank the heel 1.5–3.2 mm
-    // into the ground, and the curve lift its clearance rounds needed (4.4 cm at 2 km/h) was
-    // carried into every later swing.
+    // symmetric heel strike puts the hip half a step ahead (why not a half step: docs/klaw.md).
     if opts.stop && steps.len() > 1 {
         let f = steps.last_mut().into_iter().next();
         if let Some(f) = f {

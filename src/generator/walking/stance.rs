@@ -28,33 +28,21 @@
 //!    flexion — to its desired length at the end of the step; `P` is a shooting unknown.
 //!
 //! **The push-off (a change to the paper's hip path, issue 6).** The paper gives no profile for
-//! `pa`; with the quadratic one (`n = 2`) the leg reaches its eq. 3 length at whatever rate the
-//! profile leaves, and the hip arrives at heel strike descending at −0.51 m/s (5 km/h, 1.8 m;
-//! −0.82 at 7 km/h: ≈ 2–4 × a human's, whose hip is near its lowest there — the paper's own rule
-//! is that it "must never drop below its minimal value at heel strike"). The new leg then
-//! shortens at that approach from the first instant, and the drawn foot, whose straight knee has
-//! no leverage, rolls about the heel at 15–20 rad/s for 1–2 frames (the continuity spike at
-//! every heel strike and frame 0 of 4–7 km/h walks). Above a Froude speed the profile is
-//! `τⁿ` with `n` growing with speed ([`push_off_exponent`]): the same extension, put late —
-//! the trailing leg's push-off (its heel rising fast just before the other heel lands). The end
-//! conditions, the shooting and its unknowns are unchanged. Measured at heel strike (1.8 m,
-//! `n` 2 → the exponent): ẇ(t_step) 0.31 → 0.50 m/s (5 km/h), 0.49 → 0.99 (7 km/h); the hip's
-//! vertical velocity −0.51 → −0.35 and −0.82 → −0.40 m/s. The push-off also lengthens a leg
-//! tilted forward, so the hip's forward speed grows (1.80 → 1.88, 2.37 → 2.64 m/s) and its
-//! approach along the new leg only drops by 9–12 % (1.24 → 1.13, 1.90 → 1.68 m/s): what changes
-//! most is the new stance's start (θ̇1 1.59 → 1.76 rad/s at 5 km/h, a smaller step torque), and
-//! the drawn roll decays over more frames. Larger exponents were tried: `n = 6` at 5 km/h lands
-//! the hip level but leaves the trailing knee straightening to rest within a frame of heel
-//! strike (continuity 9–24 on the trailing knee at 2.0 m), hence the moderate slope.
+//! `pa`; with the quadratic one (`n = 2`) the hip arrives at heel strike descending at 2–4 × a
+//! human's rate (the paper's own rule is that it "must never drop below its minimal value at
+//! heel strike"), and the new leg, whose straight knee has no leverage, rolls the drawn foot
+//! about the heel. Above a Froude speed the profile is `τⁿ` with `n` growing with speed
+//! ([`push_off_exponent`]): the same extension, put late — the trailing leg's push-off (its
+//! heel rising fast just before the other heel lands). The end conditions, the shooting and its
+//! unknowns are unchanged (measured effect and the exponents tried: docs/klaw.md).
 //!
 //! **The midstance knee (a change to the paper's lock, issue 6).** The paper locks the rigid
 //! leg at its unloaded length `l1` — a straight knee through midstance. At speed the leg locks
 //! shorter, at `l1 (1 − δ)` ([`StanceSpec::lock_short`], [`lock_shortening`]: δ grows with the
 //! push-off exponent up to 1 %, a midstance knee flexion of ≈ 16°, the upper end of a human's at
 //! brisk speeds); the extension then lengthens the leg from there to its eq. 3 length, so the
-//! hip vaults lower and arrives at heel strike descending more slowly (measured, 1.8 m, pelvis
-//! vertical velocity before contact: 5 km/h −0.34 → −0.22 m/s, 7 km/h −0.48 → −0.30; the vault
-//! above heel strike 5.0 → 4.2 cm and 7.9 → 7.1 cm). The virtual leg draws the flexed knee
+//! hip vaults lower and arrives at heel strike descending more slowly (measured: docs/klaw.md).
+//! The virtual leg draws the flexed knee
 //! ([`StanceSpec::drawn_span`]). A leg that bottoms out above the shorter length locks where
 //! it turns, as above.
 //!

@@ -442,14 +442,9 @@ impl VirtualLeg {
                 table
             };
             // When the flat foot's knee rate at `end` exceeds the mean rate (slow walks: the hip
-            // still descends as the foot lands), a start at the mean rate makes the knee's rate
-            // dip mid-rocker and rise again — a knee that flexes, nearly stops and flexes again
-            // (continuity ratios ≈ 6.5 at heel strike at 1 km/h). There the knee leaves heel
-            // strike at the slowest valid rate below the mean, down to rest (C¹ with the swing's
-            // locked knee), so its rate rises toward the flat foot's — unless the landing is
-            // already as quick as this pass allows (within ×1.2 of its shortest): the knee must
-            // then help from the start, or the foot slaps down harder (toe 5.0 cm/frame on the
-            // 5 → 3 km/h step of a schedule).
+            // still descends as the foot lands) the knee leaves heel strike at the slowest valid
+            // rate below the mean, down to rest (C¹ with the swing's locked knee), unless the
+            // landing is already within ×1.2 of its shortest (why: docs/klaw.md).
             let mut f = f_mean;
             if self.slow_knee_start
                 && f_mean == 1.0
@@ -508,11 +503,7 @@ impl VirtualLeg {
             // the straight leg's reach, and the held roll is out of reach too: the foot rocks
             // through flat onto its ball (foot flat and heel off at once), where the heel-off
             // rule keeps the ankle within reach, instead of hovering pitched a little up and
-            // being lifted off the ground by the straight leg. Why: a stance leg that locked
-            // above `l1` (the first faster step after a slow one: the ramped 1 → 7 km/h × 2.0 m
-            // walk's 2.5 km/h stance, 0.11 mm short of flat at its closest, then 2.5 mm beyond
-            // reach through midstance) hovered its foot 2–3 mm up and left the ground flat,
-            // with no foot-flat or heel-off event.
+            // being lifted off the ground by the straight leg (why: docs/klaw.md).
             let rocks_over = self.rocker_gap.is_some_and(|last| gap > last) && g(self.rho) > 0.0;
             if gap <= 0.0 || rocks_over {
                 self.period = FootPeriod::Flat;
