@@ -6,6 +6,10 @@
 //! KLAW uses it for its shooting (§4.1: the paper's bisection refined by the secant method,
 //! `walking::shooting`), for locating events on the integrator's discrete flow
 //! (`walking::integrate`) and for the virtual leg's foot-roll rules (`walking::virtual_leg`).
+//!
+//! [`bisect`] is the plain bisection on a predicate (a side, not a sign: where the quantity is
+//! not continuous or only its side is known), for KLAW's one-dimensional searches in the swing,
+//! the first step, the ankle curve's knee and the drawn pelvis's rise.
 
 /// When [`illinois`] stops.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,9 +135,46 @@ pub fn illinois(
     out
 }
 
+/// Bisection of `[lo, hi]` on a predicate: up to `halvings` times, and while `|hi − lo| > tol`,
+/// the midpoint `m` replaces `lo` where `lo_side(m)` holds and `hi` where it does not. Returns
+/// the final `(lo, hi)` (`lo` may be the larger end).
+pub fn bisect(
+    lo: f64,
+    hi: f64,
+    halvings: usize,
+    tol: f64,
+    mut lo_side: impl FnMut(f64) -> bool,
+) -> (f64, f64) {
+    let (mut lo, mut hi) = (lo, hi);
+    for _ in 0..halvings {
+        if (hi - lo).abs() <= tol {
+            break;
+        }
+        let m = 0.5 * (lo + hi);
+        if lo_side(m) {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    (lo, hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn bisect_keeps_each_end_on_its_side() {
+        // x² < 2 on the lo side: the ends close on √2 from either order of the bracket.
+        let (lo, hi) = bisect(0.0, 2.0, 60, 0.0, |x| x * x < 2.0);
+        assert!(lo * lo < 2.0 && hi * hi >= 2.0 && (hi - lo).abs() < 1e-15);
+        let (lo, hi) = bisect(3.0, 1.0, 60, 0.0, |x| x * x >= 2.0);
+        assert!((lo - 2f64.sqrt()).abs() < 1e-15 && hi < lo);
+        // The tolerance stops it early: 2/2^k ≤ 0.01 after 8 halvings.
+        let (lo, hi) = bisect(0.0, 2.0, usize::MAX, 0.01, |x| x * x < 2.0);
+        assert!((hi - lo - 2.0 / 256.0).abs() < 1e-15);
+    }
 
     #[test]
     fn finds_a_cube_root_to_tolerance_in_few_evaluations() {

@@ -1,5 +1,6 @@
 //! Swing1's ankle curve `P` (§4.3: a 4th-order polynomial through five conditions) and the knee
 //! slaved to it: the knee angle that puts the ankle on the curve, continuing its branch.
+use crate::generator::numeric::bisect;
 
 /// Where the ankle curve peaks, as a fraction of its travel `D` (§4.3: `C = 0.3·D`).
 pub(super) const PEAK_AT: f64 = 0.3;
@@ -164,14 +165,7 @@ pub fn knee_on_circle(k: [f64; 2], l4: f64, th3: f64, curve: &AnkleCurve, guess:
     if res(b).0 * dir <= 0.0 {
         return ext;
     }
-    for _ in 0..60 {
-        let m = 0.5 * (a + b);
-        if res(m).0 * dir > 0.0 {
-            b = m;
-        } else {
-            a = m;
-        }
-    }
+    let (a, b) = bisect(a, b, 60, 0.0, |m| res(m).0 * dir <= 0.0);
     let root = 0.5 * (a + b);
     if (root - guess).abs() <= KNEE_BRANCH_STEP {
         root

@@ -41,9 +41,7 @@
 //! 5. The A.2 hip accelerations are printed correctly; `ẋ_h`, `ẏ_h` do not enter the swing
 //!    equations (the Lagrangian derivation confirms their terms cancel).
 use super::body::Body;
-
-/// Standard gravity used by the dynamics, m/s².
-pub const G: f64 = crate::units::G;
+use crate::units::G;
 
 /// Solves the 3×3 symmetric positive definite system `a x = b` by Cholesky.
 pub(crate) fn solve3(a: &[[f64; 3]; 3], b: &[f64; 3]) -> [f64; 3] {

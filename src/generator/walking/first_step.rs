@@ -6,6 +6,7 @@ use super::draw::sagittal_angles;
 use super::dynamics::{HipMotion, StanceModel};
 use super::virtual_leg::VirtualLeg;
 use crate::generator::curves::smoothstep;
+use crate::generator::numeric::bisect;
 
 /// Swings from standing that keep the paper's toe off (no brisk knee flexion at toe off,
 /// `TOE_OFF_KNEE_RATE`).
@@ -110,17 +111,9 @@ pub(super) fn first_toe_off_knee(
             sagittal_angles(hip, ankle, leg.l3, leg.l4)[0]
         })
     };
-    let (mut lo, mut hi) = (knee_now.min(leg.knee_toe_off), leg.knee_toe_off);
+    let (lo, hi) = (knee_now.min(leg.knee_toe_off), leg.knee_toe_off);
     if thigh_for(hi) >= thigh_min {
         return hi;
     }
-    for _ in 0..20 {
-        let mid = 0.5 * (lo + hi);
-        if thigh_for(mid) < thigh_min {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    lo
+    bisect(lo, hi, 20, 0.0, |k| thigh_for(k) >= thigh_min).0
 }

@@ -27,6 +27,7 @@ pub use super::first_step::FIRST_TOE_OFF_THIGH;
 use super::first_step::*;
 use super::pelvis_drop::{flat_drop, pelvis_smooth_tau, PelvisDrop, PelvisLowering};
 pub use super::WalkOptions;
+use crate::generator::numeric::bisect;
 
 /// What happened in one step: its constraints, the shooting effort and how well each phase met
 /// its final conditions.
@@ -393,19 +394,11 @@ pub fn generate_steps(
             })
         };
         // The largest rise that covers (bisection: the drop's rise is continuous in the need).
-        let (mut lo, mut hi) = (t_flat_end * closest.max(8) as f64 / 64.0, t_flat_end);
+        let (mut lo, hi) = (t_flat_end * closest.max(8) as f64 / 64.0, t_flat_end);
         if covers(hi) {
             lo = hi;
         }
-        while hi - lo > 1e-6 {
-            let mid = 0.5 * (lo + hi);
-            if covers(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let rise = lo;
+        let rise = bisect(lo, hi, usize::MAX, 1e-6, &covers).0;
         let drop = PelvisDrop {
             height: drop_to,
             rise,

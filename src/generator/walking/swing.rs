@@ -33,6 +33,7 @@ use super::integrate::{integrate, spectral_radius, stable_step};
 use super::shooting::{solve_1d, solve_1d_with, solve_2d_with, Solved};
 pub use super::swing_foot::{SwingFoot, CLEARANCE_RAMP_MIN, CLEARANCE_SOFT};
 use super::track::{Node, Track};
+use crate::generator::numeric::bisect;
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -342,17 +343,8 @@ impl SwingSpec<'_> {
         if self.foot_points(t1, &[self.theta3_hs, th4]).toe[1] < self.clearance {
             let toe_y =
                 |k4: f64| self.foot_points(t1, &[self.theta3_hs, k4]).toe[1] - self.clearance;
-            let (mut lo, mut hi) = (th4, th4 + 1.5);
-            if toe_y(hi) > 0.0 {
-                for _ in 0..60 {
-                    let m = 0.5 * (lo + hi);
-                    if toe_y(m) > 0.0 {
-                        hi = m;
-                    } else {
-                        lo = m;
-                    }
-                }
-                th4 = hi;
+            if toe_y(th4 + 1.5) > 0.0 {
+                th4 = bisect(th4, th4 + 1.5, 60, 0.0, |k| toe_y(k) <= 0.0).1;
             }
         }
         let (_, mut a1) = self.joints(t1, &[self.theta3_hs, th4]);
@@ -363,17 +355,8 @@ impl SwingSpec<'_> {
         let d_min = MIN_TRAVEL * (a_hs[0] - a0[0]);
         if a1[0] - a0[0] < d_min && d_min > 0.0 {
             let travel = |k4: f64| self.joints(t1, &[self.theta3_hs, k4]).1[0] - a0[0] - d_min;
-            let (mut lo, mut hi) = (0.0, th4);
-            if travel(lo) > 0.0 {
-                for _ in 0..60 {
-                    let m = 0.5 * (lo + hi);
-                    if travel(m) > 0.0 {
-                        lo = m;
-                    } else {
-                        hi = m;
-                    }
-                }
-                th4 = lo;
+            if travel(0.0) > 0.0 {
+                th4 = bisect(0.0, th4, 60, 0.0, |k| travel(k) > 0.0).0;
                 a1 = self.joints(t1, &[self.theta3_hs, th4]).1;
             }
         }
