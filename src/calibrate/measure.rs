@@ -6,6 +6,7 @@ use crate::events::kinematic::Kinematics;
 use crate::events::{
     analyse, steps_from_analysis, EventKind, EventOptions, Gait, PrimarySource, Side,
 };
+use crate::ingest::trials::StepRow;
 use crate::ingest::types::{MarkerSet, Trial};
 
 /// Number of samples of a normalised-cycle curve (0, 1, …, 100 % of the stride).
@@ -181,27 +182,12 @@ pub fn measure(
         .iter()
         .filter(|r| r.time_s.is_some_and(|t| t >= window.0 && t <= window.1))
         .collect();
-    let col = |f: &dyn Fn(&crate::ingest::trials::StepRow) -> Option<f64>| -> Vec<f64> {
-        rows.iter()
-            .filter_map(|r| f(r))
-            .filter(|x| x.is_finite())
-            .collect()
-    };
-    let sf = col(&|r| r.step_freq_hz.map(|f| 60.0 * f));
-    let sl = col(&|r| r.step_length_m);
-    let (Some(cad), Some(slm)) = (mean_sd(&sf), mean_sd(&sl)) else {
-        return Err(crate::events::EventError::TooShort {
-            path,
-            reason: format!(
-                "no step with a step length and frequency between {:.2} and {:.2} s",
-                window.0, window.1
-            ),
-        });
-    };
-    let contact = mean_sd(&col(&|r| r.stance_time_s));
-    let phase = match gait {
-        Gait::Run => mean_sd(&col(&|r| r.flight_time_s)),
-        Gait::Walk => mean_sd(&col(&|r| r.double_support_pct_cycle)),
+    let no_steps = || crate::events::EventError::TooShort {
+        path: path.clone(),
+        reason: format!(
+            "no step with a step length and frequency between {:.2} and {:.2} s",
+            window.0, window.1
+        ),
     };
     // Pelvis excursion per step: max − min of the pelvis height between successive heel
     // strikes of the primary events.
@@ -228,25 +214,7 @@ pub fn measure(
             }
         }
     }
-    let exc = mean_sd(&exc);
-    let speed = slm.0 * cad.0 / 60.0;
-    let quantities = Quantities {
-        steps: rows.len(),
-        speed_m_per_s: speed,
-        cadence_steps_per_min: cad.0,
-        step_length_m: slm.0,
-        contact_time_s: contact.map(|c| c.0),
-        flight_time_s: (gait == Gait::Run).then(|| phase.map(|p| p.0)).flatten(),
-        double_support_pct_cycle: (gait == Gait::Walk).then(|| phase.map(|p| p.0)).flatten(),
-        pelvis_excursion_m: exc.map(|e| e.0),
-        sd: [
-            cad.1,
-            slm.1,
-            contact.and_then(|c| c.1),
-            phase.and_then(|p| p.1),
-            exc.and_then(|e| e.1),
-        ],
-    };
+    let quantities = quantities_of(&rows, gait, mean_sd(&exc)).ok_or_else(no_steps)?;
     let curves = an.kinematics.as_ref().and_then(|k| {
         curves(
             k,
@@ -261,6 +229,60 @@ pub fn measure(
         quantities,
         curves,
         notes,
+    })
+}
+
+/// The averaged quantities of step rows (`None` without a step that has both a step length
+/// and a frequency); `excursion` is the pelvis excursion's mean and SD, measured elsewhere.
+fn quantities_of(
+    rows: &[&StepRow],
+    gait: Gait,
+    excursion: Option<(f64, Option<f64>)>,
+) -> Option<Quantities> {
+    let col = |f: &dyn Fn(&StepRow) -> Option<f64>| -> Vec<f64> {
+        rows.iter()
+            .filter_map(|r| f(r))
+            .filter(|x| x.is_finite())
+            .collect()
+    };
+    let cad = mean_sd(&col(&|r| r.step_freq_hz.map(|f| 60.0 * f)))?;
+    let slm = mean_sd(&col(&|r| r.step_length_m))?;
+    let contact = mean_sd(&col(&|r| r.stance_time_s));
+    let phase = match gait {
+        Gait::Run => mean_sd(&col(&|r| r.flight_time_s)),
+        Gait::Walk => mean_sd(&col(&|r| r.double_support_pct_cycle)),
+    };
+    Some(Quantities {
+        steps: rows.len(),
+        speed_m_per_s: slm.0 * cad.0 / 60.0,
+        cadence_steps_per_min: cad.0,
+        step_length_m: slm.0,
+        contact_time_s: contact.map(|c| c.0),
+        flight_time_s: (gait == Gait::Run).then(|| phase.map(|p| p.0)).flatten(),
+        double_support_pct_cycle: (gait == Gait::Walk).then(|| phase.map(|p| p.0)).flatten(),
+        pelvis_excursion_m: excursion.map(|e| e.0),
+        sd: [
+            cad.1,
+            slm.1,
+            contact.and_then(|c| c.1),
+            phase.and_then(|p| p.1),
+            excursion.and_then(|e| e.1),
+        ],
+    })
+}
+
+/// Measures one trial's rows of a steps table (`gaitfit events` output, or a table of
+/// `data/`): the same averages as [`measure`] from the rows' own step quantities; no pelvis
+/// excursion and no angle curves (a steps table has no per-frame data). `None` without a step
+/// that has both a step length and a frequency.
+pub fn measure_rows(rows: &[StepRow], gait: Gait, gait_evidence: String) -> Option<Measurement> {
+    let rows: Vec<&StepRow> = rows.iter().collect();
+    Some(Measurement {
+        gait,
+        gait_evidence,
+        quantities: quantities_of(&rows, gait, None)?,
+        curves: None,
+        notes: Vec::new(),
     })
 }
 

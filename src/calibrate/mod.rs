@@ -143,7 +143,21 @@ pub fn load_subjects(
 ) -> Result<(Vec<Subject>, Vec<String>), CalibrateError> {
     let mut subjects: Vec<Subject> = Vec::new();
     let mut failed = Vec::new();
-    for input in expand_inputs(inputs)? {
+    let (tables, raw): (Vec<&PathBuf>, Vec<&PathBuf>) = inputs
+        .iter()
+        .partition(|p| p.is_file() && !crate::events::input::is_raw_input(p));
+    for path in tables {
+        match crate::ingest::trials::read_trials(path) {
+            Ok(t) => add_steps_table(&mut subjects, &mut failed, path, t.to_step_rows(), gait),
+            Err(e) => failed.push(format!("{}: {e}", path.display())),
+        }
+    }
+    let raw: Vec<PathBuf> = raw.into_iter().cloned().collect();
+    for input in if raw.is_empty() {
+        Vec::new()
+    } else {
+        expand_inputs(&raw)?
+    } {
         let label = input.label();
         if input
             .path
@@ -200,6 +214,102 @@ pub fn load_subjects(
         return Err(CalibrateError::NoInput(failed.join("; ")));
     }
     Ok((subjects, failed))
+}
+
+/// Adds the trials of a steps table (one row per step: `gaitfit events` output or a table of
+/// `data/`) as conditions: one per subject × trial, measured by [`measure::measure_rows`]; the
+/// gait from `--gait`, else the table's `gait` column (decided from the data when the table
+/// was made); the body height from its `body_height_m` (else the leg length, else 1.75 m).
+fn add_steps_table(
+    subjects: &mut Vec<Subject>,
+    failed: &mut Vec<String>,
+    path: &Path,
+    rows: Vec<crate::ingest::trials::StepRow>,
+    gait: Option<Gait>,
+) {
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in &rows {
+        let k = (r.subject.clone(), r.trial.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    for (name, trial) in keys {
+        let label = format!("{} ({name}, {trial})", path.display());
+        let tr: Vec<_> = rows
+            .iter()
+            .filter(|r| r.subject == name && r.trial == trial)
+            .cloned()
+            .collect();
+        let (g, evidence) = match gait {
+            Some(g) => (g, format!("{g}: given with --gait")),
+            None => {
+                let runs = tr.iter().filter(|r| r.gait == Some(Gait::Run)).count();
+                let walks = tr.iter().filter(|r| r.gait == Some(Gait::Walk)).count();
+                if runs + walks == 0 {
+                    failed.push(format!("{label}: no gait in the table; give --gait"));
+                    continue;
+                }
+                let g = if runs > walks { Gait::Run } else { Gait::Walk };
+                (
+                    g,
+                    format!("{g}: the steps table's gait column ({runs} run, {walks} walk rows)"),
+                )
+            }
+        };
+        let Some(m) = measure::measure_rows(&tr, g, evidence) else {
+            failed.push(format!("{label}: no step with a step length and frequency"));
+            continue;
+        };
+        let median = |v: Vec<f64>| -> Option<f64> {
+            let mut v: Vec<f64> = v.into_iter().filter(|x| x.is_finite()).collect();
+            v.sort_by(f64::total_cmp);
+            (!v.is_empty()).then(|| v[v.len() / 2])
+        };
+        let mut notes = vec![format!(
+            "measured from the steps table {} (no per-frame data: no pelvis excursion, no angle curves)",
+            path.display()
+        )];
+        let h = median(tr.iter().filter_map(|r| r.body_height_m).collect())
+            .filter(|h| *h > 0.5)
+            .unwrap_or_else(|| {
+                match median(tr.iter().filter_map(|r| r.leg_length_m).collect())
+                    .filter(|l| *l > 0.3)
+                {
+                    Some(l) => {
+                        notes.push(format!(
+                            "body height not in the table: {:.3} m from the leg length {l:.3} m (leg ≈ 0.53 h)",
+                            l / 0.53
+                        ));
+                        l / 0.53
+                    }
+                    None => {
+                        notes.push("body height not in the table: 1.75 m assumed".into());
+                        1.75
+                    }
+                }
+            });
+        let cond = Condition {
+            trial,
+            path: path.display().to_string(),
+            measured: m,
+            rows: tr,
+        };
+        match subjects.iter_mut().find(|s| s.name == name && s.gait == g) {
+            Some(s) => {
+                s.conditions.push(cond);
+                s.notes.extend(notes);
+            }
+            None => subjects.push(Subject {
+                name,
+                gait: g,
+                body_height_m: h,
+                mass_kg: 0.0,
+                conditions: vec![cond],
+                notes,
+            }),
+        }
+    }
 }
 
 /// Adds joint centres carried from a `static.trc` beside a trial whose markers have only

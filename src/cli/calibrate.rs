@@ -8,7 +8,9 @@ use std::process::ExitCode;
 /// Arguments of `gaitfit calibrate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Measured trials: files or folders (TRC + GRF, C3D, MOT, WBDS, gaitfit CSV).
+    /// Measured trials: files or folders (TRC + GRF, C3D, MOT, WBDS, gaitfit CSV), or steps
+    /// tables (one row per step with `subject` and `gait` columns, as `gaitfit events` writes
+    /// them: one condition per subject × trial, no pelvis excursion or angle curves).
     #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Folder of fitted relations (`gaitfit fit`); without it the relations are refitted on the
