@@ -192,15 +192,22 @@ pub fn leave_one_out(subjects: &[&Subject]) -> Option<KbLeaveOneOut> {
 }
 
 /// The Ko–Badler stage of a walking subject with two or more conditions: per condition, the
-/// measurement of its generalization from the nearest other condition (`None` for runs and
-/// single-condition subjects).
+/// measurement of its generalization from the nearest other condition (`None` for runs,
+/// single-condition subjects and subjects without markers, e.g. from a steps table).
 pub fn kb_stage(
     subject: &Subject,
     fps: f64,
     steps: usize,
     variant: Variant,
 ) -> Option<super::solve::Stage> {
-    if subject.gait != Gait::Walk || subject.conditions.len() < 2 {
+    // A subject without markers (a steps table) has no prototype walk to generalize.
+    if subject.gait != Gait::Walk
+        || subject.conditions.len() < 2
+        || subject
+            .conditions
+            .iter()
+            .all(|c| c.measured.curves.is_none())
+    {
         return None;
     }
     let mut notes = Vec::new();

@@ -3,7 +3,9 @@
 use super::drive::{attr_defs, SLOPED};
 use super::measure::{rms_corr, Curves, Measurement, CYCLE_POINTS};
 use super::solve::value;
-use super::{CalibrateError, CalibratedAttr, CalibratedFile, CalibratedSubject, Calibration};
+use super::{
+    CalibrateError, CalibratedAttr, CalibratedFile, CalibratedSubject, Calibration, SubjectResult,
+};
 use crate::events::Gait;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -282,6 +284,176 @@ fn curve_svg(title: &str, series: &[(&str, &str, bool, &[f64])]) -> String {
     s
 }
 
+/// One series of a speed plot: label, colour, dashed, points (speed m/s, value, ± SD).
+type SpeedSeries<'a> = (&'a str, &'a str, bool, Vec<(f64, f64, Option<f64>)>);
+
+/// An inline SVG of one fitted quantity against speed, the calibration's fit plot: the measured
+/// means (± the step-to-step SD) and each stage's generated values, every point marked (a
+/// subject measured at one speed has one point per series) and joined across speeds.
+fn speed_svg(title: &str, series: &[SpeedSeries]) -> String {
+    let (w, h, ml, mr, mt, mb) = (360.0, 220.0, 44.0, 10.0, 24.0, 30.0);
+    let pts: Vec<(f64, f64, Option<f64>)> = series
+        .iter()
+        .flat_map(|s| s.3.iter().copied())
+        .filter(|p| p.0.is_finite() && p.1.is_finite())
+        .collect();
+    let range = |v: &mut dyn Iterator<Item = f64>, min_half: f64| {
+        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        if !(lo.is_finite() && hi.is_finite()) {
+            return (0.0, 1.0);
+        }
+        let mid = 0.5 * (lo + hi);
+        let half = (0.5 * (hi - lo)).max(min_half) * 1.1;
+        (mid - half, mid + half)
+    };
+    let (x0, x1) = range(&mut pts.iter().map(|p| p.0), 0.25);
+    let (y0, y1) = range(
+        &mut pts
+            .iter()
+            .flat_map(|p| [p.1 - p.2.unwrap_or(0.0), p.1 + p.2.unwrap_or(0.0)]),
+        1e-6,
+    );
+    let x = |v: f64| ml + (w - ml - mr) * (v - x0) / (x1 - x0);
+    let y = |v: f64| mt + (h - mt - mb) * (1.0 - (v - y0) / (y1 - y0));
+    let d = (2.0 - (y1 - y0).log10().floor()).clamp(0.0, 4.0) as usize;
+    let mut s = format!(
+        "<svg class=\"fig\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"{t}\">\
+         <text x=\"{ml}\" y=\"15\" font-size=\"12\">{t}</text>\
+         <rect x=\"{ml}\" y=\"{mt}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"#999\"/>",
+        t = esc(title),
+        pw = w - ml - mr,
+        ph = h - mt - mb
+    );
+    for k in 0..=4 {
+        let v = y0 + (y1 - y0) * k as f64 / 4.0;
+        let u = x0 + (x1 - x0) * k as f64 / 4.0;
+        let _ = write!(
+            s,
+            "<text x=\"{}\" y=\"{:.1}\" font-size=\"9\" text-anchor=\"end\">{v:.d$}</text>\
+             <text x=\"{:.1}\" y=\"{}\" font-size=\"9\" text-anchor=\"middle\">{u:.2}</text>",
+            ml - 3.0,
+            y(v) + 3.0,
+            x(u),
+            h - mb + 12.0
+        );
+    }
+    for (n, (label, colour, dashed, v)) in series.iter().enumerate() {
+        let dash = if *dashed {
+            " stroke-dasharray=\"5,3\""
+        } else {
+            ""
+        };
+        let v: Vec<_> = v
+            .iter()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        if v.len() > 1 {
+            let line: Vec<String> = v
+                .iter()
+                .map(|p| format!("{:.1},{:.1}", x(p.0), y(p.1)))
+                .collect();
+            let _ = write!(
+                s,
+                "<polyline class=\"series\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.4\"{dash} points=\"{}\"/>",
+                line.join(" ")
+            );
+        }
+        // A cross at each point, and the ± SD bar.
+        let mut marks = String::new();
+        for p in &v {
+            let (px, py) = (x(p.0), y(p.1));
+            let _ = write!(
+                marks,
+                "M{:.1},{py:.1}L{:.1},{py:.1}M{px:.1},{:.1}L{px:.1},{:.1}",
+                px - 4.0,
+                px + 4.0,
+                py - 4.0,
+                py + 4.0
+            );
+            if let Some(sd) = p.2.filter(|sd| *sd > 0.0) {
+                let _ = write!(
+                    marks,
+                    "M{px:.1},{:.1}L{px:.1},{:.1}",
+                    y(p.1 - sd),
+                    y(p.1 + sd)
+                );
+            }
+        }
+        let _ = write!(
+            s,
+            "<path class=\"series\" fill=\"none\" stroke=\"{colour}\" stroke-width=\"1.4\" d=\"{marks}\"/>"
+        );
+        let ly = h - 6.0;
+        let lx = ml + ((w - ml - mr) / series.len() as f64).min(110.0) * n as f64;
+        let _ = write!(
+            s,
+            "<line x1=\"{lx}\" y1=\"{ly}\" x2=\"{}\" y2=\"{ly}\" stroke=\"{colour}\"{dash}/>\
+             <text x=\"{}\" y=\"{}\" font-size=\"9\">{}</text>",
+            lx + 14.0,
+            lx + 17.0,
+            ly + 3.0,
+            esc(label)
+        );
+    }
+    s.push_str("</svg>");
+    s
+}
+
+/// The fit plots of a subject: cadence, step length and flight or double support against speed
+/// (measured ± SD, relations, calibrated, and held out when computed).
+fn fit_plots(r: &SubjectResult) -> String {
+    let s = &r.subject;
+    let mut out = String::new();
+    let phase = match s.gait {
+        Gait::Run => ("flight (ms)", 1000.0),
+        Gait::Walk => ("double support (% cycle)", 1.0),
+    };
+    for (q, (name, scale)) in [
+        (0, ("cadence (steps/min)", 1.0)),
+        (1, ("step length (cm)", 100.0)),
+        (3, phase),
+    ] {
+        let of = |st: &[Result<Measurement, String>]| -> Vec<(f64, f64, Option<f64>)> {
+            s.conditions
+                .iter()
+                .zip(st)
+                .filter_map(|(c, g)| {
+                    let v = value(g.as_ref().ok()?, q)?;
+                    Some((c.speed(), scale * v, None))
+                })
+                .collect()
+        };
+        let measured: Vec<_> = s
+            .conditions
+            .iter()
+            .filter_map(|c| {
+                let v = value(&c.measured, q)?;
+                let sd = c.measured.quantities.sd[q].map(|sd| scale * sd);
+                Some((c.speed(), scale * v, sd))
+            })
+            .collect();
+        if measured.is_empty() {
+            continue;
+        }
+        let mut series: Vec<SpeedSeries> = vec![
+            ("measured ± SD", "#000", false, measured),
+            ("relations", "#1f77b4", true, of(&r.before.generated)),
+            ("calibrated", "#d62728", false, of(&r.after.generated)),
+        ];
+        if let Some(ho) = &r.held_out {
+            series.push(("held out", "#2ca02c", true, of(&ho.generated)));
+        }
+        out.push_str(&speed_svg(
+            &format!("{}: {name} against speed (m/s)", s.name),
+            &series,
+        ));
+    }
+    out
+}
+
 fn fmt(v: Option<f64>, d: usize) -> String {
     match v {
         Some(v) if v.is_finite() => format!("{v:.d$}"),
@@ -482,6 +654,7 @@ pub fn write_report(path: &Path, cal: &Calibration) -> Result<(), CalibrateError
             }
         }
         h.push_str("</table><div class=\"figs\">");
+        h.push_str(&fit_plots(r));
         for (c, cond) in s.conditions.iter().enumerate() {
             let Some(mc) = &cond.measured.curves else {
                 continue;
