@@ -81,8 +81,7 @@ pub(super) fn smooth_rolls(data: &mut [StepData]) {
     // start the first step is the unrecorded pre-roll (whose trailing leg has no history and is
     // never drawn), and the recorded walk's first trailing leg is the pre-roll's stance leg,
     // joined with it below as every later step's (smoothed alone over the recorded double
-    // support, its start was a free end: with the forward-mean smoother that was the
-    // 7 km/h × 1.5 m toe-bend jump at frame 2, ratio 25.5).
+    // support its start was a free end: docs/klaw.md).
     if let Some(d) = data.first_mut() {
         let times: Vec<f64> = d.trail_rho.iter().map(|s| d.start + s.0).collect();
         let mut rho: Vec<f64> = d.trail_rho.iter().map(|s| s.1).collect();

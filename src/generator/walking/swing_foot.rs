@@ -97,10 +97,9 @@ impl SwingFoot {
     /// the lower of toe and ball at the clearance, through a smooth maximum of width
     /// [`CLEARANCE_SOFT`] (ramped in with the clearance after toe-off, faded out over swing3,
     /// so toe-off and heel strike keep their pitches):
-    /// a hard maximum engages and releases with a kink in the ankle's rate, which the short
-    /// spells of clearance in fast walks turned into one-to-three-frame spikes (continuity
-    /// ratios 5–7.5 on the ankle a third of the way into the swing at 7 km/h). The smooth
-    /// maximum is never below either, so the foot clears at least as before.
+    /// a hard maximum engages and releases with a kink in the ankle's rate (measured:
+    /// docs/klaw.md). The smooth maximum is never below either, so the foot clears at least as
+    /// before.
     pub fn pose(&self, t: f64, ankle: [f64; 2], shank: f64) -> (f64, f64) {
         let [t0, _, t2, t3] = self.times;
         let (th5, th6) = self.theta56(t);

@@ -566,10 +566,8 @@ impl VirtualLeg {
             self.transitions[2] = Some(t);
             // Start from the roll the heel-off rule found for this sample (a little past
             // `meta_off_rho`, by at most one sample's roll), not from `meta_off_rho` itself:
-            // dropping back to it moved the ankle away from the hip within one 2 ms sample, and
-            // the nearly straight knee straightened by up to 0.014 rad there (1.2–1.4 km/h walks
-            // between the grid points failed k = 5 at 5.2–11.1, most where the switch fell on
-            // the toe-off sample and set the swing's starting rates).
+            // dropping back to it moved the ankle away from the hip within one 2 ms sample
+            // (docs/klaw.md).
             self.rho = rho.max(self.rho);
             let p = self.pose_at(hip, dz, self.rho);
             self.meta_start = Some((t, p.knee));
