@@ -1075,6 +1075,21 @@ impl<F: Fn(f64) -> f64> CostFunction for OneD<F> {
     }
 }
 
+/// The points [`minimize_1d`] evaluates first on `[lo, hi]` (its scan of [`MIN1D_GRID`] cells),
+/// in order.
+pub fn minimize_1d_grid(lo: f64, hi: f64) -> Vec<f64> {
+    let h = (hi - lo) / MIN1D_GRID as f64;
+    (0..=MIN1D_GRID)
+        .map(|k| {
+            if k == MIN1D_GRID {
+                hi
+            } else {
+                lo + h * k as f64
+            }
+        })
+        .collect()
+}
+
 /// Minimises `f` on `[lo, hi]`: a scan of [`MIN1D_GRID`] cells finds the best bracket (profiles
 /// of breakpoints are often multimodal), then argmin's Brent minimiser (`BrentOpt`) polishes it
 /// to `tol` in x ([`MIN1D_DEFAULT_TOL`] when `tol ≤ 0`). Returns `(x*, f(x*))`.
@@ -1105,16 +1120,9 @@ pub fn minimize_1d<F: Fn(f64) -> f64>(
             v
         }
     };
-    let h = (hi - lo) / MIN1D_GRID as f64;
-    let grid: Vec<(f64, f64)> = (0..=MIN1D_GRID)
-        .map(|k| {
-            let x = if k == MIN1D_GRID {
-                hi
-            } else {
-                lo + h * k as f64
-            };
-            (x, eval(x))
-        })
+    let grid: Vec<(f64, f64)> = minimize_1d_grid(lo, hi)
+        .into_iter()
+        .map(|x| (x, eval(x)))
         .collect();
     let (kbest, &(xb, fb)) = grid
         .iter()

@@ -58,8 +58,8 @@ use crate::fit::forms::{DistinctKeys, Fitting};
 use crate::ingest::trials::TrialsTable;
 use crate::relations::{Fitted, Inputs, ParamKind, Relation};
 use profile::{
-    confidence_set, profile, refit, whole_subjects, FoldEngine, FoldKeys, Members, ProfileGrid,
-    Profiler, SortedRows, Source, Subset,
+    confidence_set, profile, refit, share_first_grid, whole_subjects, FoldEngine, FoldKeys,
+    Members, ProfileGrid, Profiler, SortedRows, Source, Subset,
 };
 
 mod band;
@@ -789,6 +789,9 @@ pub fn fit_relation(
                     [i] => plan.search[i].and_then(|r| FoldEngine::new(sr, &lay, &p, i, r)),
                     _ => None,
                 };
+                if engine.is_none() {
+                    share_first_grid(sr, rel, &free, &plan.search, &p, &bps);
+                }
                 (0..n_subj)
                     .into_par_iter()
                     .map(|s| {

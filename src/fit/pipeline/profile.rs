@@ -618,6 +618,40 @@ pub(super) fn whole_subjects(prep: &Prepared, rows: &[usize]) -> Option<Vec<(usi
         .collect()
 }
 
+/// Before leave-one-subject-out folds without a [`FoldEngine`]: every fold's first breakpoint
+/// search (when continuous, [`minimize_1d`]) first scans the same grid at the same other
+/// parameters `p` (the whole data's estimate) whenever its range is the whole data's `search`,
+/// and its evaluations subtract the fold's subject from the tree over all rows: that tree's
+/// part of the grid is computed once ([`SortedRows::memoise_all`]; the same numbers).
+pub(super) fn share_first_grid(
+    sr: &SortedRows,
+    rel: &dyn Relation,
+    free: &[bool],
+    search: &[Option<(f64, f64)>],
+    p: &[f64],
+    bps: &[usize],
+) {
+    let Some(&i) = bps.first() else { return };
+    let Some((lo, hi)) = search[i] else { return };
+    if sr.form().discrete_breakpoint(i) {
+        return;
+    }
+    // The free parameters as `refit` passes them on (breakpoints without a range fixed).
+    let params = &rel.card().parameters;
+    let fold_free: Vec<bool> = (0..free.len())
+        .map(|j| free[j] && !(params[j].kind == ParamKind::Breakpoint && search[j].is_none()))
+        .collect();
+    let ps: Vec<Vec<f64>> = crate::fit::nonlinear::minimize_1d_grid(lo, hi)
+        .into_iter()
+        .map(|x| {
+            let mut q = p.to_vec();
+            q[i] = x;
+            q
+        })
+        .collect();
+    sr.memoise_all(&ps, &fold_free);
+}
+
 /// Refits everything (breakpoints included) on a subset: the global coefficient vector, or
 /// `None` if the subset cannot be fitted.
 pub(super) fn refit(

@@ -9,6 +9,8 @@ use crate::fit::forms::{
 };
 use crate::relations::Observation;
 use nalgebra::DVector;
+use std::cell::RefCell;
+use std::collections::HashMap;
 use std::sync::OnceLock;
 
 /// Subjects from which an evaluation with a per-subject column sums the subjects in parallel
@@ -258,6 +260,26 @@ pub(in crate::fit::pipeline) struct SortedRows<'a> {
     /// Subject of each row of `all`, in key order.
     pub(super) key_subject: Vec<u32>,
     pub(super) subj: Vec<Tree>,
+    /// The tree over all rows' sums at some queries (see [`SortedRows::memoise_all`]).
+    all_memo: OnceLock<HashMap<MemoKey, FeatureSums>>,
+}
+
+/// Every input of a query of the tree over all rows, bit for bit: range ends, inclusiveness,
+/// centre and the removed key interval (if any).
+type MemoKey = [u64; 6];
+
+fn memo_key(r: KeyRange, centre: f64, remove: Option<(f64, f64)>) -> MemoKey {
+    let flags =
+        r.lo_inclusive as u64 | (r.hi_inclusive as u64) << 1 | (remove.is_some() as u64) << 2;
+    let (c1, c2) = remove.unwrap_or((0.0, 0.0));
+    [
+        r.lo.to_bits(),
+        r.hi.to_bits(),
+        flags,
+        centre.to_bits(),
+        c1.to_bits(),
+        c2.to_bits(),
+    ]
 }
 
 /// A key mapped to an integer of the same order as `f64::total_cmp` (for a fast sort).
@@ -424,7 +446,50 @@ impl<'a> SortedRows<'a> {
             all,
             key_subject,
             subj,
+            all_memo: OnceLock::new(),
         }
+    }
+
+    /// Memoises the tree over all rows' sums at every query the form's normal equations make at
+    /// each of `ps` (free parameters `free`). A later query with the same inputs (bit for bit)
+    /// starts from the memoised sums, which are the very numbers its own pass over the tree
+    /// would add to zero: results do not change. The leave-one-subject-out folds' first
+    /// breakpoint search evaluates the same grid of the same parameters in every fold, each
+    /// fold only subtracting its subject's sums, so this shares that grid's whole-tree part.
+    /// Only the first call has an effect.
+    pub fn memoise_all(&self, ps: &[Vec<f64>], free: &[bool]) {
+        use rayon::prelude::*;
+        struct Recorder<'q> {
+            q: Query<'q>,
+            log: RefCell<Vec<(MemoKey, FeatureSums)>>,
+        }
+        impl KeySums for Recorder<'_> {
+            fn range(&self, r: KeyRange, centre: f64) -> FeatureSums {
+                let mut out = [0.0; MAX_PROFILE_FEATURES];
+                self.q.add(&self.q.sr.all, r, centre, 1.0, &mut out);
+                self.log.borrow_mut().push((memo_key(r, centre, None), out));
+                out
+            }
+        }
+        let logs: Vec<Vec<(MemoKey, FeatureSums)>> = ps
+            .par_iter()
+            .map(|p| {
+                let rec = Recorder {
+                    q: Query {
+                        sr: self,
+                        members: Members::All,
+                        remove: None,
+                    },
+                    log: RefCell::new(Vec::new()),
+                };
+                let _ = self
+                    .ctx
+                    .form
+                    .normal_equations(p, free, &self.ctx.scale, &rec);
+                rec.log.into_inner()
+            })
+            .collect();
+        let _ = self.all_memo.set(logs.into_iter().flatten().collect());
     }
 
     /// The relation's sorted form.
@@ -492,13 +557,25 @@ impl Query<'_> {
     }
 }
 
+impl Query<'_> {
+    /// Adds the tree over all rows' sums over `r` to `out` (zero): from the memo when it holds
+    /// this query (the same numbers).
+    fn add_all(&self, r: KeyRange, centre: f64, out: &mut FeatureSums) {
+        let memo = self.sr.all_memo.get();
+        match memo.and_then(|m| m.get(&memo_key(r, centre, self.remove))) {
+            Some(v) => *out = *v,
+            None => self.add(&self.sr.all, r, centre, 1.0, out),
+        }
+    }
+}
+
 impl KeySums for Query<'_> {
     fn range(&self, r: KeyRange, centre: f64) -> FeatureSums {
         let mut out = [0.0; MAX_PROFILE_FEATURES];
         match self.members {
-            Members::All => self.add(&self.sr.all, r, centre, 1.0, &mut out),
+            Members::All => self.add_all(r, centre, &mut out),
             Members::AllBut(s) => {
-                self.add(&self.sr.all, r, centre, 1.0, &mut out);
+                self.add_all(r, centre, &mut out);
                 self.add(&self.sr.subj[s], r, centre, -1.0, &mut out);
             }
             Members::List(l) => {
@@ -648,6 +725,48 @@ mod tests {
             }
         }
         assert!(lazy.all.nodes.get().is_some());
+    }
+
+    #[test]
+    fn memoised_whole_tree_sums_give_the_same_fold_solves() {
+        let published = RunTflightSf::published();
+        let rel: &dyn Relation = &published;
+        let form = rel.sorted_profile().expect("sorted form");
+        let mut prep = Prepared::default();
+        for i in 0..3000usize {
+            let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
+            prep.obs.push(Observation {
+                x: crate::relations::Inputs::new(&[sf]),
+                y: 0.1 + 1e-4 * (sf - 200.0) + 1e-3 * ((i % 13) as f64 - 6.0),
+            });
+            prep.subject.push(i % 4);
+            prep.weights.push(1.0 + (i % 3) as f64);
+        }
+        prep.subjects = (0..4).map(|s| format!("s{s}")).collect();
+        let plain = SortedRows::new(form, &prep, true);
+        let memo = SortedRows::new(form, &prep, true);
+        let free = vec![true; 9];
+        let lay = Layout::new(rel, free.clone(), 3);
+        let p0 = published.coefficients().to_vec();
+        let at = |k2: f64| {
+            let mut p = p0.clone();
+            p[8] = k2;
+            p
+        };
+        let grid: Vec<Vec<f64>> = [185.0, 190.5, 201.25, 230.0].map(at).to_vec();
+        memo.memoise_all(&grid, &free);
+        assert!(!memo.all_memo.get().expect("memo").is_empty());
+        // Memoised points and others, every fold: the same solves, bit for bit.
+        for p in grid.iter().cloned().chain([at(195.0)]) {
+            for s in 0..4 {
+                let solve = |sr: &SortedRows| solve_sorted(sr, &lay, &p, Members::AllBut(s), None);
+                let (a, b) = (solve(&plain).expect("a"), solve(&memo).expect("b"));
+                assert!(
+                    a.0 == b.0 && a.1.to_bits() == b.1.to_bits(),
+                    "{p:?} fold {s}"
+                );
+            }
+        }
     }
 
     #[test]
