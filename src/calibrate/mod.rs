@@ -186,21 +186,8 @@ pub fn load_subjects(
                     measured: m,
                     rows,
                 };
-                let g = cond.measured.gait;
-                match subjects.iter_mut().find(|s| s.name == name && s.gait == g) {
-                    Some(s) => {
-                        s.conditions.push(cond);
-                        s.notes.extend(notes);
-                    }
-                    None => subjects.push(Subject {
-                        name,
-                        gait: g,
-                        body_height_m: h,
-                        mass_kg: trial.subject.mass_kg.unwrap_or(0.0),
-                        conditions: vec![cond],
-                        notes,
-                    }),
-                }
+                let mass = trial.subject.mass_kg.unwrap_or(0.0);
+                add_condition(&mut subjects, name, (h, mass), cond, notes);
             }
             Err(e) => failed.push(format!("{label}: {e}")),
         }
@@ -295,20 +282,36 @@ fn add_steps_table(
             measured: m,
             rows: tr,
         };
-        match subjects.iter_mut().find(|s| s.name == name && s.gait == g) {
-            Some(s) => {
-                s.conditions.push(cond);
-                s.notes.extend(notes);
-            }
-            None => subjects.push(Subject {
-                name,
-                gait: g,
-                body_height_m: h,
-                mass_kg: 0.0,
-                conditions: vec![cond],
-                notes,
-            }),
+        add_condition(subjects, name, (h, 0.0), cond, notes);
+    }
+}
+
+/// Files `cond` (and its notes) under the subject of that name and gait, or starts the subject
+/// with `body` = (height m, mass kg; 0 unknown) when it is the first of its conditions.
+fn add_condition(
+    subjects: &mut Vec<Subject>,
+    name: String,
+    (body_height_m, mass_kg): (f64, f64),
+    cond: Condition,
+    notes: Vec<String>,
+) {
+    let gait = cond.measured.gait;
+    match subjects
+        .iter_mut()
+        .find(|s| s.name == name && s.gait == gait)
+    {
+        Some(s) => {
+            s.conditions.push(cond);
+            s.notes.extend(notes);
         }
+        None => subjects.push(Subject {
+            name,
+            gait,
+            body_height_m,
+            mass_kg,
+            conditions: vec![cond],
+            notes,
+        }),
     }
 }
 

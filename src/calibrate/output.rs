@@ -198,6 +198,20 @@ fn esc(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// The opening of a figure's inline SVG: the `<svg>` element of `size` (width, height), the
+/// title and the plot frame inside the margins (left, right, top, bottom).
+fn svg_open(title: &str, (w, h): (f64, f64), (ml, mr, mt, mb): (f64, f64, f64, f64)) -> String {
+    format!(
+        "<svg class=\"fig\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
+         viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"{t}\">\
+         <text x=\"{ml}\" y=\"15\" font-size=\"12\">{t}</text>\
+         <rect x=\"{ml}\" y=\"{mt}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"#999\"/>",
+        t = esc(title),
+        pw = w - ml - mr,
+        ph = h - mt - mb
+    )
+}
+
 /// An inline SVG of curves over the normalised cycle: (label, colour, dashed, values).
 fn curve_svg(title: &str, series: &[(&str, &str, bool, &[f64])]) -> String {
     let (w, h, ml, mr, mt, mb) = (360.0, 220.0, 44.0, 10.0, 24.0, 30.0);
@@ -222,15 +236,7 @@ fn curve_svg(title: &str, series: &[(&str, &str, bool, &[f64])]) -> String {
     let (lo, hi) = (lo - pad, hi + pad);
     let x = |i: usize| ml + (w - ml - mr) * i as f64 / (CYCLE_POINTS - 1) as f64;
     let y = |v: f64| mt + (h - mt - mb) * (1.0 - (v - lo) / (hi - lo));
-    let mut s = format!(
-        "<svg class=\"fig\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"{t}\">\
-         <text x=\"{ml}\" y=\"15\" font-size=\"12\">{t}</text>\
-         <rect x=\"{ml}\" y=\"{mt}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"#999\"/>",
-        t = esc(title),
-        pw = w - ml - mr,
-        ph = h - mt - mb
-    );
+    let mut s = svg_open(title, (w, h), (ml, mr, mt, mb));
     for k in 0..=4 {
         let v = lo + (hi - lo) * k as f64 / 4.0;
         let _ = write!(
@@ -318,15 +324,7 @@ fn speed_svg(title: &str, series: &[SpeedSeries]) -> String {
     let x = |v: f64| ml + (w - ml - mr) * (v - x0) / (x1 - x0);
     let y = |v: f64| mt + (h - mt - mb) * (1.0 - (v - y0) / (y1 - y0));
     let d = (2.0 - (y1 - y0).log10().floor()).clamp(0.0, 4.0) as usize;
-    let mut s = format!(
-        "<svg class=\"fig\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" \
-         viewBox=\"0 0 {w} {h}\" role=\"img\" aria-label=\"{t}\">\
-         <text x=\"{ml}\" y=\"15\" font-size=\"12\">{t}</text>\
-         <rect x=\"{ml}\" y=\"{mt}\" width=\"{pw}\" height=\"{ph}\" fill=\"none\" stroke=\"#999\"/>",
-        t = esc(title),
-        pw = w - ml - mr,
-        ph = h - mt - mb
-    );
+    let mut s = svg_open(title, (w, h), (ml, mr, mt, mb));
     for k in 0..=4 {
         let v = y0 + (y1 - y0) * k as f64 / 4.0;
         let u = x0 + (x1 - x0) * k as f64 / 4.0;
