@@ -35,7 +35,7 @@
 //! only when the objective falls, and shrinks it otherwise.
 //!
 //! Stopping: MINPACK's convergence tests, through the same argmin wrapper as
-//! [`crate::fit::nonlinear::nls`] (`fit::nonlinear::Stopping`): an accepted step that lowered
+//! [`crate::fit::nonlinear::nls`] (`fit::stopping::Stopping`): an accepted step that lowered
 //! the objective by at most [`FTOL`] relative (and the model predicted no more), a step or a
 //! trust radius below [`XTOL`] relative to the parameters, every Jacobian column within cosine
 //! [`GTOL`] of orthogonal to the residuals, or a zero residual. Otherwise the solver stops at
@@ -47,7 +47,7 @@ use super::drive::{self, AttrModel, Relations};
 use super::measure::Measurement;
 use super::{measure_generated, CalibrateError, CalibrateOptions, Subject, SubjectResult};
 use crate::events::Gait;
-use crate::fit::nonlinear::Stopping;
+use crate::fit::stopping::Stopping;
 use argmin::core::{CostFunction, Executor, Gradient, Hessian, State, TerminationReason};
 use argmin::solver::trustregion::{Steihaug, TrustRegion};
 use nalgebra::{DMatrix, DVector};

@@ -31,6 +31,7 @@ pub mod pipeline;
 pub mod prec;
 pub mod record;
 pub mod stats;
+pub(crate) mod stopping;
 pub mod strd;
 pub mod synthetic;
 pub mod wild;
