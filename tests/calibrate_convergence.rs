@@ -9,6 +9,8 @@
 //! with the default cap it converges before the cap and the calibrated run has the synthetic
 //! run's cadence and step length (the synthetic motion is the reference, measured by the
 //! event pipeline on both sides). A few seconds.
+#[path = "common/calibrate.rs"]
+mod calibrate_cli;
 use std::path::Path;
 
 fn gaitfit() -> assert_cmd::Command {
@@ -43,19 +45,7 @@ fn calibrate(
     out: &Path,
     extra: &[&str],
 ) -> (String, serde_json::Value, String, String) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let o = gaitfit()
-        .arg("calibrate")
-        .arg(input)
-        .arg("--fits")
-        .arg(root.join("fits"))
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .assert()
-        .success()
-        .get_output()
-        .clone();
+    let o = calibrate_cli::run(input, out, extra);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("calibrated.json")).unwrap())
             .unwrap();

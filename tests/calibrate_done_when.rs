@@ -9,9 +9,10 @@
 //!
 //! The references are the measured trials, not gaitfit's earlier output. Ignored by default
 //! (needs ../shared/data); a few seconds.
+#[path = "common/calibrate.rs"]
+mod calibrate_cli;
 use std::collections::HashMap;
 use std::path::Path;
-use std::process::Command;
 
 /// (quantity, speed rounded to cm/s) → (measured, generated) of stage `calibrated`.
 fn calibrated(dir: &Path) -> HashMap<(String, i64), (f64, f64)> {
@@ -59,18 +60,7 @@ fn calibrate(input: &Path, out: &Path) {
 }
 
 fn calibrate_with(input: &Path, out: &Path, extra: &[&str]) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let status = Command::new(env!("CARGO_BIN_EXE_gaitfit"))
-        .arg("calibrate")
-        .arg(input)
-        .arg("--fits")
-        .arg(root.join("fits"))
-        .arg("--out")
-        .arg(out)
-        .args(extra)
-        .status()
-        .expect("run gaitfit calibrate");
-    assert!(status.success(), "gaitfit calibrate failed: {status}");
+    calibrate_cli::run(input, out, extra);
 }
 
 #[test]

@@ -6,6 +6,8 @@
 //! tables as on the raw files: Hamner subject01 Run_3 cadence within 2 %, step length within
 //! 3 %, flight within 15 ms; Schreiber 2014001 double support within 1 % of the cycle at both
 //! speeds. Not ignored (data/ is in the repository); a few seconds.
+#[path = "common/calibrate.rs"]
+mod calibrate_cli;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -31,19 +33,7 @@ type Residuals = HashMap<(i64, String), (f64, f64)>;
 
 /// Calibrates `input`; returns stderr and its calibrated residuals.
 fn calibrate(input: &Path, out: &Path) -> (String, Residuals) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let o = assert_cmd::Command::cargo_bin("gaitfit")
-        .unwrap()
-        .arg("calibrate")
-        .arg(input)
-        .arg("--fits")
-        .arg(root.join("fits"))
-        .arg("--out")
-        .arg(out)
-        .assert()
-        .success()
-        .get_output()
-        .clone();
+    let o = calibrate_cli::run(input, out, &[]);
     let csv = std::fs::read_to_string(out.join("residuals.csv")).unwrap();
     let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
