@@ -687,12 +687,9 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_lazy_tree_over_all_rows_equals_the_eager_one() {
-        let rel = RunTflightSf::published();
-        let form = (&rel as &dyn Relation)
-            .sorted_profile()
-            .expect("sorted form");
+    /// 3,000 weighted rows of 4 subjects, step frequencies 150–250 steps/min spread over the
+    /// knots, flight times linear with a subject-periodic wobble.
+    fn four_subject_rows() -> Prepared {
         let mut prep = Prepared::default();
         for i in 0..3000usize {
             let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
@@ -704,6 +701,16 @@ mod tests {
             prep.weights.push(1.0 + (i % 3) as f64);
         }
         prep.subjects = (0..4).map(|s| format!("s{s}")).collect();
+        prep
+    }
+
+    #[test]
+    fn the_lazy_tree_over_all_rows_equals_the_eager_one() {
+        let rel = RunTflightSf::published();
+        let form = (&rel as &dyn Relation)
+            .sorted_profile()
+            .expect("sorted form");
+        let prep = four_subject_rows();
         let eager = SortedRows::new(form, &prep, true);
         let lazy = SortedRows::new(form, &prep, false);
         assert!(lazy.all.nodes.get().is_none());
@@ -732,17 +739,7 @@ mod tests {
         let published = RunTflightSf::published();
         let rel: &dyn Relation = &published;
         let form = rel.sorted_profile().expect("sorted form");
-        let mut prep = Prepared::default();
-        for i in 0..3000usize {
-            let sf = 150.0 + ((i * 7919) % 1000) as f64 * 0.1;
-            prep.obs.push(Observation {
-                x: crate::relations::Inputs::new(&[sf]),
-                y: 0.1 + 1e-4 * (sf - 200.0) + 1e-3 * ((i % 13) as f64 - 6.0),
-            });
-            prep.subject.push(i % 4);
-            prep.weights.push(1.0 + (i % 3) as f64);
-        }
-        prep.subjects = (0..4).map(|s| format!("s{s}")).collect();
+        let prep = four_subject_rows();
         let plain = SortedRows::new(form, &prep, true);
         let memo = SortedRows::new(form, &prep, true);
         let free = vec![true; 9];
