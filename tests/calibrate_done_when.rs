@@ -88,6 +88,13 @@ fn hamner_run_3_calibrated() {
     let (_, knee) = get("knee_flexion_rms_deg");
     println!("knee RMS {knee:.1}°");
     assert!(knee.is_finite() && knee > 0.0, "knee RMS {knee}");
+    // Pearson's r of the two knee curves: measured 1, generated r.
+    let (m, r) = get("knee_flexion_corr");
+    println!("knee correlation {r:.3}");
+    assert!(
+        m == 1.0 && (-1.0..=1.0).contains(&r),
+        "knee r {r} (measured {m})"
+    );
     converged_before_the_cap(tmp.path());
 }
 

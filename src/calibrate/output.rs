@@ -46,8 +46,11 @@ fn scalar_quantities(gait: Gait) -> [(&'static str, &'static str, f64); 5] {
     ]
 }
 
-/// The residual rows of every subject, condition, quantity and stage (angle RMS rows where
-/// both sides have curves: measured = 0, generated = residual = the RMS difference).
+/// The residual rows of every subject, condition, quantity and stage. Where both sides have
+/// angle curves over the normalised cycle, two rows per angle: `<angle>_rms_deg` (measured = 0,
+/// generated = residual = the RMS difference) and `<angle>_corr` (Pearson's r of the two
+/// curves, unit 1: measured = 1, generated = r, residual = r − 1), issue 21's "RMS and
+/// correlation".
 pub fn residual_rows(cal: &Calibration) -> Vec<ResidualRow> {
     let mut out = Vec::new();
     for r in &cal.subjects {
@@ -80,18 +83,23 @@ pub fn residual_rows(cal: &Calibration) -> Vec<ResidualRow> {
                 }
                 if let (Some(mc), Some(gc)) = (&m.curves, g.and_then(|g| g.curves.as_ref())) {
                     for (name, a, b) in curve_pairs(mc, gc) {
-                        let (rms, _) = rms_corr(a, b);
-                        out.push(ResidualRow {
-                            subject: s.name.clone(),
-                            gait: s.gait,
-                            speed_m_per_s: cond.speed(),
-                            quantity: format!("{name}_rms_deg"),
-                            unit: "deg".into(),
-                            measured: 0.0,
-                            generated: rms,
-                            residual: rms,
-                            stage: stage_name,
-                        });
+                        let (rms, r) = rms_corr(a, b);
+                        for (quantity, unit, measured, generated) in [
+                            (format!("{name}_rms_deg"), "deg", 0.0, rms),
+                            (format!("{name}_corr"), "1", 1.0, r),
+                        ] {
+                            out.push(ResidualRow {
+                                subject: s.name.clone(),
+                                gait: s.gait,
+                                speed_m_per_s: cond.speed(),
+                                quantity,
+                                unit: unit.into(),
+                                measured,
+                                generated,
+                                residual: generated - measured,
+                                stage: stage_name,
+                            });
+                        }
                     }
                 }
             }
