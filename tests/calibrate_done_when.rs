@@ -259,3 +259,36 @@ fn hamner_leave_one_speed_out() {
         );
     }
 }
+
+/// A force-only MOT (Hamner's GRF without its TRC) is timed by the forces but has no distance:
+/// calibrate says that step lengths are missing and why, naming the file once, instead of
+/// calling the trial "too short for one stride".
+#[test]
+#[ignore = "needs ../shared/data"]
+fn a_force_only_mot_says_what_is_missing() {
+    let grf = gaitfit::shared_data::require("hamner2013/subject01/Run_2_grf.mot");
+    let tmp = tempfile::tempdir().expect("temp dir");
+    let mot = tmp.path().join("Run_2_grf.mot");
+    std::fs::copy(&grf, &mot).expect("copy the MOT alone");
+    let out = assert_cmd::Command::cargo_bin("gaitfit")
+        .expect("the gaitfit binary")
+        .arg("calibrate")
+        .arg(&mot)
+        .arg("--fits")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("fits"))
+        .arg("--out")
+        .arg(tmp.path().join("cal"))
+        .assert()
+        .failure()
+        .get_output()
+        .clone();
+    let err = String::from_utf8_lossy(&out.stderr);
+    println!("{err}");
+    assert!(err.contains("missing step lengths"), "{err}");
+    assert!(
+        err.contains("force data alone measures no distance"),
+        "{err}"
+    );
+    assert_eq!(err.matches("Run_2_grf.mot").count(), 1, "{err}");
+    assert!(!tmp.path().join("cal").join("report.html").exists());
+}

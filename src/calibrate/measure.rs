@@ -182,12 +182,32 @@ pub fn measure(
         .iter()
         .filter(|r| r.time_s.is_some_and(|t| t >= window.0 && t <= window.1))
         .collect();
-    let no_steps = || crate::events::EventError::TooShort {
-        path: path.clone(),
-        reason: format!(
-            "no step with a step length and frequency between {:.2} and {:.2} s",
-            window.0, window.1
-        ),
+    let no_steps = || {
+        let within = if window.0.is_finite() || window.1.is_finite() {
+            format!(" starting between {:.2} and {:.2} s", window.0, window.1)
+        } else {
+            String::new()
+        };
+        // Steps timed by the forces but without a length: nothing in the trial measures
+        // distance (no markers, no belt speed), which is not a short record.
+        let unmeasured = rows
+            .iter()
+            .any(|r| r.step_freq_hz.is_some() && r.step_length_m.is_none());
+        if unmeasured && trial.markers.is_none() {
+            crate::events::EventError::Missing {
+                path: path.clone(),
+                what: format!(
+                    "step lengths{within}: the steps are timed by the forces, but force data alone \
+                     measures no distance; give the trial's markers (e.g. its TRC beside the \
+                     MOT) or a treadmill's belt speed"
+                ),
+            }
+        } else {
+            crate::events::EventError::TooShort {
+                path: path.clone(),
+                reason: format!("no step with a step length and frequency{within}"),
+            }
+        }
     };
     // Pelvis excursion per step: max − min of the pelvis height between successive heel
     // strikes of the primary events.

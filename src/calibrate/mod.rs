@@ -169,7 +169,7 @@ pub fn load_subjects(
         let mut trial = match read_input(&input, &ReadOptions::default()) {
             Ok(t) => t,
             Err(e) => {
-                failed.push(format!("{label}: {e}"));
+                failed.push(labelled(&label, e));
                 continue;
             }
         };
@@ -189,7 +189,7 @@ pub fn load_subjects(
                 let mass = trial.subject.mass_kg.unwrap_or(0.0);
                 add_condition(&mut subjects, name, (h, mass), cond, notes);
             }
-            Err(e) => failed.push(format!("{label}: {e}")),
+            Err(e) => failed.push(labelled(&label, e)),
         }
     }
     for s in &mut subjects {
@@ -312,6 +312,17 @@ fn add_condition(
             conditions: vec![cond],
             notes,
         }),
+    }
+}
+
+/// `error` prefixed with the input's `label`, unless its message already starts with it (the
+/// readers' and the event pipeline's errors name their file).
+fn labelled(label: &str, error: impl std::fmt::Display) -> String {
+    let msg = error.to_string();
+    if msg.starts_with(label) {
+        msg
+    } else {
+        format!("{label}: {msg}")
     }
 }
 
