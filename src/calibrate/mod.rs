@@ -257,25 +257,12 @@ fn add_steps_table(
             "measured from the steps table {} (no per-frame data: no pelvis excursion, no angle curves)",
             path.display()
         )];
-        let h = median(tr.iter().filter_map(|r| r.body_height_m).collect())
-            .filter(|h| *h > 0.5)
-            .unwrap_or_else(|| {
-                match median(tr.iter().filter_map(|r| r.leg_length_m).collect())
-                    .filter(|l| *l > 0.3)
-                {
-                    Some(l) => {
-                        notes.push(format!(
-                            "body height not in the table: {:.3} m from the leg length {l:.3} m (leg ≈ 0.53 h)",
-                            l / 0.53
-                        ));
-                        l / 0.53
-                    }
-                    None => {
-                        notes.push("body height not in the table: 1.75 m assumed".into());
-                        1.75
-                    }
-                }
-            });
+        let (h, hn) = body_height_from(
+            median(tr.iter().filter_map(|r| r.body_height_m).collect()),
+            median(tr.iter().filter_map(|r| r.leg_length_m).collect()),
+            "the table",
+        );
+        notes.extend(hn);
         let cond = Condition {
             trial,
             path: path.display().to_string(),
@@ -357,21 +344,33 @@ fn add_static_joint_centres(trial: &mut Trial, path: &Path, notes: &mut Vec<Stri
 /// Body height from the trial, else from the leg length (Bruderlin & Calvert 1989 Table B-1,
 /// thigh + shank = 0.48225 h, with the hip height ≈ leg + 0.039 h ankle height), else 1.75 m.
 fn body_height(trial: &Trial) -> (f64, Vec<String>) {
-    if let Some(h) = trial.subject.body_height_m.filter(|h| *h > 0.5) {
+    body_height_from(
+        trial.subject.body_height_m,
+        trial.subject.leg_length_m,
+        "the data",
+    )
+}
+
+/// The body height from a measured `height` (> 0.5 m), else from the leg length (> 0.3 m,
+/// [`crate::events::steps::LEG_LENGTH_PER_BODY_HEIGHT`]), else 1.75 m; with a note naming
+/// `source` when it was not measured.
+fn body_height_from(height: Option<f64>, leg: Option<f64>, source: &str) -> (f64, Vec<String>) {
+    use crate::events::steps::LEG_LENGTH_PER_BODY_HEIGHT as LEG;
+    if let Some(h) = height.filter(|h| *h > 0.5) {
         return (h, Vec::new());
     }
-    if let Some(l) = trial.subject.leg_length_m.filter(|l| *l > 0.3) {
-        let h = l / 0.53;
+    if let Some(l) = leg.filter(|l| *l > 0.3) {
+        let h = l / LEG;
         return (
             h,
             vec![format!(
-                "body height not in the data: {h:.3} m from the leg length {l:.3} m (leg ≈ 0.53 h)"
+                "body height not in {source}: {h:.3} m from the leg length {l:.3} m (leg ≈ {LEG} h)"
             )],
         );
     }
     (
         1.75,
-        vec!["body height not in the data: 1.75 m assumed".to_string()],
+        vec![format!("body height not in {source}: 1.75 m assumed")],
     )
 }
 

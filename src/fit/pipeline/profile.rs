@@ -732,7 +732,8 @@ mod tests {
     use crate::fit::forms::Fitting;
     use crate::relations::{Inputs, RunTflightSf};
 
-    /// Flight times on a line with two jumps the free pieces cannot follow inside a piece: a small one at sf = 170 and a large one at sf = 196, so the profile of
+    /// Flight times on a line with two jumps the free pieces cannot follow inside a piece: a
+    /// small one at sf = 170 and a large one at sf = 196, so the profile of
     /// k1 has a local minimum at the small jump and its global minimum at the large one.
     fn two_jumps() -> Prepared {
         let mut prep = Prepared::default();
