@@ -957,6 +957,106 @@ pub fn minimize_1d<F: Fn(f64) -> f64>(
     hi: f64,
     tol: f64,
 ) -> Result<(f64, f64), FitError> {
+    minimize_1d_impl(f, None::<fn(f64, f64) -> f64>, f64::NAN, lo, hi, tol)
+}
+
+/// [`minimize_1d`] with a lower bound of `f` on intervals, `lower(a, b) ≤ f(t)` for every `t`
+/// in `[a, b]` *as `f` computes it* (so allowing for `f`'s rounding; `−∞` or NaN when there is
+/// none): the same result, bit for bit, from fewer evaluations of `f`.
+///
+/// # Why the result is the same
+/// [`minimize_1d`]'s result is a function of the index of the *first* minimum of `f` over its
+/// grid ([`minimize_1d_grid`]), of that minimum's value, and of `f` inside the bracket around
+/// it (Brent's method evaluates there only). Here that index is found by branch and bound over
+/// ranges of grid indices: the grid point nearest `warm` is evaluated first (the incumbent), a
+/// range `a..=b` is discarded when `lower(grid[a], grid[b])` exceeds the best value found
+/// (then every point in it is strictly worse than the incumbent, so none of them is the first
+/// minimum), and the others are bisected, their middle points evaluated. Every grid point is thus evaluated or
+/// proven strictly worse than an evaluated one, and ties among evaluated points go to the lower
+/// index, as `min_by` does. `warm` only changes how much is discarded.
+pub fn minimize_1d_bounded<F: Fn(f64) -> f64, L: Fn(f64, f64) -> f64>(
+    f: F,
+    lower: L,
+    warm: f64,
+    lo: f64,
+    hi: f64,
+    tol: f64,
+) -> Result<(f64, f64), FitError> {
+    minimize_1d_impl(f, Some(lower), warm, lo, hi, tol)
+}
+
+/// The first minimum `(index, value)` of `eval` over `xs`: every point evaluated without a
+/// bound, by branch and bound with one (see [`minimize_1d_bounded`]).
+fn grid_argmin<E: Fn(f64) -> f64, L: Fn(f64, f64) -> f64>(
+    xs: &[f64],
+    eval: &E,
+    lower: Option<L>,
+    warm: f64,
+) -> (usize, f64) {
+    let Some(lower) = lower else {
+        return xs
+            .iter()
+            .map(|&x| eval(x))
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or((0, f64::INFINITY));
+    };
+    let n = xs.len();
+    let mut seen = vec![false; n];
+    let mut best = (f64::INFINITY, usize::MAX);
+    let mut visit = |k: usize, best: &mut (f64, usize)| {
+        if !seen[k] {
+            seen[k] = true;
+            let v = eval(xs[k]);
+            // `min_by(total_cmp)`'s order; equal values go to the lower index.
+            if v.total_cmp(&best.0).then(k.cmp(&best.1)).is_lt() {
+                *best = (v, k);
+            }
+        }
+    };
+    let w = if warm.is_finite() {
+        (0..n)
+            .min_by(|&a, &b| (xs[a] - warm).abs().total_cmp(&(xs[b] - warm).abs()))
+            .unwrap_or(0)
+    } else {
+        0
+    };
+    visit(w, &mut best);
+    // Open ranges of indices `(bound, a, b, own)`, the lowest bound first: a range enters with
+    // its parent's bound (valid for it too) and gets its own only when it comes first, so the
+    // bounds of ranges that never come first are not computed; a single point is evaluated.
+    let mut open: Vec<(f64, usize, usize, bool)> = vec![(f64::NEG_INFINITY, 0, n - 1, true)];
+    while let Some(i) = (0..open.len()).min_by(|&i, &j| open[i].0.total_cmp(&open[j].0)) {
+        let (lb, a, b, own) = open.swap_remove(i);
+        if lb > best.0 {
+            break;
+        }
+        if a == b {
+            visit(a, &mut best);
+        } else if !own {
+            let v = lower(xs[a], xs[b]);
+            // NaN: no bound.
+            open.push((if v.is_nan() { lb } else { v.max(lb) }, a, b, true));
+        } else {
+            let m = a + (b - a) / 2;
+            open.push((lb, m, m, false));
+            if m > a {
+                open.push((lb, a, m - 1, false));
+            }
+            open.push((lb, m + 1, b, false));
+        }
+    }
+    (best.1.min(n - 1), best.0)
+}
+
+fn minimize_1d_impl<F: Fn(f64) -> f64, L: Fn(f64, f64) -> f64>(
+    f: F,
+    lower: Option<L>,
+    warm: f64,
+    lo: f64,
+    hi: f64,
+    tol: f64,
+) -> Result<(f64, f64), FitError> {
     if !(lo.is_finite() && hi.is_finite() && lo < hi) {
         return Err(FitError::InvalidInput {
             relation: "minimize_1d".into(),
@@ -972,26 +1072,17 @@ pub fn minimize_1d<F: Fn(f64) -> f64>(
             v
         }
     };
-    let grid: Vec<(f64, f64)> = minimize_1d_grid(lo, hi)
-        .into_iter()
-        .map(|x| (x, eval(x)))
-        .collect();
-    let (kbest, &(xb, fb)) = grid
-        .iter()
-        .enumerate()
-        .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
-        .ok_or_else(|| FitError::Optimizer {
-            relation: "minimize_1d".into(),
-            message: "empty grid".into(),
-        })?;
+    let xs = minimize_1d_grid(lo, hi);
+    let (kbest, fb) = grid_argmin(&xs, &eval, lower, warm);
+    let xb = xs[kbest];
     if !fb.is_finite() {
         return Err(FitError::Optimizer {
             relation: "minimize_1d".into(),
             message: format!("the function is not finite anywhere on [{lo}, {hi}]"),
         });
     }
-    let a = grid[kbest.saturating_sub(1)].0;
-    let b = grid[(kbest + 1).min(MIN1D_GRID)].0;
+    let a = xs[kbest.saturating_sub(1)];
+    let b = xs[(kbest + 1).min(MIN1D_GRID)];
     let solver = BrentOpt::new(a, b).set_tolerance(f64::EPSILON.sqrt(), tol);
     let res = Executor::new(OneD(&eval), solver)
         .configure(|s| s.max_iters(500))

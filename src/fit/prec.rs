@@ -53,6 +53,15 @@ pub const MIN1D_DEFAULT_TOL: f64 = 1.0e-10;
 /// polishes the best bracket (profiles of breakpoints are often multimodal).
 pub const MIN1D_GRID: usize = 64;
 
+/// Allowance for rounding in a breakpoint window's lower bound of the profile RSS (as a
+/// fraction of the rows' `yᵀWy`): a relaxed fit's RSS minus this is what
+/// [`crate::fit::nonlinear::minimize_1d_bounded`] receives. RSS from normal equations
+/// (`yᵀWy − βᵀXᵀWy`, `solve_normal`) carries a rounding error of about `ε·κ·yᵀWy`; with the
+/// centred, unit-diagonal bases κ stays far below 1e5 (5 or more distinct keys per piece), so
+/// both the bound's and the profile's own error are below 1e-10·yᵀWy and this allowance covers
+/// their sum with room to spare.
+pub const PROFILE_BOUND_SLACK: f64 = 1.0e-9;
+
 /// Convergence tolerance of [`crate::fit::ols::huber_irls`]: stop when no coefficient moves by
 /// more than this times its standard error between iterations.
 pub const IRLS_TOL: f64 = 1.0e-10;

@@ -233,6 +233,29 @@ pub trait SortedProfile: Sync {
     fn discrete_breakpoint(&self, _i: usize) -> bool {
         false
     }
+    /// True when [`window_relaxation`](Self::window_relaxation) gives lower bounds for
+    /// breakpoint `i` (the default: no).
+    fn relaxes(&self, _i: usize) -> bool {
+        false
+    }
+    /// A relaxation of breakpoint `i`'s profile over a window `[ta, tb]` of its values: normal
+    /// equations, from `sums` over the rows *without those with key in `[ta, tb)`*, whose
+    /// least-squares residual sum of squares is at most the profile's (the fit with the
+    /// breakpoint at `t`, the other coefficients as in `p`) at every `t` in the window. `None`
+    /// when there is none for these values.
+    #[allow(clippy::too_many_arguments)]
+    fn window_relaxation(
+        &self,
+        _p: &[f64],
+        _free: &[bool],
+        _i: usize,
+        _ta: f64,
+        _tb: f64,
+        _scale: &KeyScale,
+        _sums: &dyn KeySums,
+    ) -> Option<NormalEquations> {
+        None
+    }
 }
 
 /// Distinct keys, ascending, seen as a sorted list without some of its positions: a

@@ -342,6 +342,65 @@ mod feat {
 }
 
 impl TflightForm {
+    /// [`SortedProfile::normal_equations`]; with `tied_plateau` false the rows above k2 are
+    /// left out (for [`SortedProfile::window_relaxation`]).
+    fn equations(
+        &self,
+        p: &[f64],
+        free: &[bool],
+        scale: &KeyScale,
+        sums: &dyn KeySums,
+        tied_plateau: bool,
+    ) -> NormalEquations {
+        let l = Layout::new(p, free, self.continuity);
+        let nb = l.nb();
+        let (k1, k2) = (p[7], p[8]);
+        let mut ne = NormalEquations::zeros(nb);
+        let h = scale.half_width;
+        // Each piece's sums are taken about the middle of its rows' key range, so the
+        // polynomials below are well conditioned however narrow the piece.
+        let (dlo, dhi) = (scale.centre - h, scale.centre + h);
+        let centre = |a: f64, b: f64| {
+            let (a, b) = (a.max(dlo), b.min(dhi));
+            if a <= b {
+                0.5 * (a + b)
+            } else {
+                scale.centre
+            }
+        };
+        let sf = |c: f64| [c, h, 0.0, 0.0];
+        let u = |c: f64| [(c - l.m1) / l.s1, h / l.s1, 0.0, 0.0];
+        let w = |c: f64| [(c - l.m2) / l.s2, h / l.s2, 0.0, 0.0];
+        // Pieces: sf < k1 quadratic; k1 ≤ sf ≤ k2 cubic; above both, the cubic at k2.
+        let cb = centre(f64::NEG_INFINITY, k1);
+        let below = sums.range(KeyRange::below(k1, false), cb);
+        let mut cols = [[0.0; 4]; 7];
+        let off = self.below_polys(&l, p, &u(cb), &sf(cb), &mut cols);
+        add_piece(&mut ne, &below, &cols[..nb], &off);
+        let plateau = if k1 <= k2 {
+            let cm = centre(k1, k2);
+            let middle = sums.range(KeyRange::closed(k1, k2), cm);
+            let mut cols = [[0.0; 4]; 7];
+            let off = self.upper_polys(&l, p, &w(cm), &sf(cm), &mut cols);
+            add_piece(&mut ne, &middle, &cols[..nb], &off);
+            KeyRange::above(k2, false)
+        } else {
+            KeyRange::above(k1, true)
+        };
+        let plateau = if tied_plateau {
+            sums.range(plateau, scale.centre)
+        } else {
+            [0.0; super::MAX_PROFILE_FEATURES]
+        };
+        if plateau[0] != 0.0 {
+            let mut cols = [[0.0; 4]; 7];
+            let wk = (k2 - l.m2) / l.s2;
+            let off = self.upper_polys(&l, p, &pc(wk), &pc(k2), &mut cols);
+            add_piece(&mut ne, &plateau, &cols[..nb], &off);
+        }
+        ne
+    }
+
     /// The basis columns and offset of the quadratic piece (sf < k1) as polynomials, given u and
     /// sf as polynomials in ω (mirrors [`Form::basis`]).
     fn below_polys(&self, l: &Layout, p: &[f64], u: &Poly, s: &Poly, out: &mut [Poly; 7]) -> Poly {
@@ -511,48 +570,65 @@ impl SortedProfile for TflightForm {
         scale: &KeyScale,
         sums: &dyn KeySums,
     ) -> NormalEquations {
-        let l = Layout::new(p, free, self.continuity);
-        let nb = l.nb();
+        self.equations(p, free, scale, sums, true)
+    }
+    fn relaxes(&self, i: usize) -> bool {
+        // k1 of the free pieces is discrete (searched over partitions, no bound needed).
+        i == 8 || (i == 7 && self.continuity == Continuity::Continuous)
+    }
+    /// - k1 (continuous variant), window below k2: the **free** pieces' equations with k1 = ta
+    ///   on the rows outside `[ta, tb)`. For any `t` in the window and any continuous fit, the
+    ///   rows below ta are on the quadratic and those from tb to k2 on the cubic for every t, so
+    ///   its RSS is a sum of nonnegative terms over more rows, of a model that the free pieces
+    ///   (no continuity, a superset) contain: never less than the relaxed fit's.
+    /// - k2 (either variant), window above k1: the pieces below ta as the model has them (k2 =
+    ///   ta), the rows in `[ta, tb)` dropped, and those from tb on fitted by a constant of
+    ///   their own (one extra column). At any `t` in the window the rows in `[k1, ta)` are on
+    ///   the cubic, and every row from tb on sits at the cubic's value at `t` — a constant (a row
+    ///   at tb itself: the cubic at min(tb, t) = t) — so the relaxed fit contains every fit with
+    ///   the plateau at `t`, on fewer rows.
+    fn window_relaxation(
+        &self,
+        p: &[f64],
+        free: &[bool],
+        i: usize,
+        ta: f64,
+        tb: f64,
+        scale: &KeyScale,
+        sums: &dyn KeySums,
+    ) -> Option<NormalEquations> {
         let (k1, k2) = (p[7], p[8]);
-        let mut ne = NormalEquations::zeros(nb);
-        let h = scale.half_width;
-        // Each piece's sums are taken about the middle of its rows' key range, so the
-        // polynomials below are well conditioned however narrow the piece.
-        let (dlo, dhi) = (scale.centre - h, scale.centre + h);
-        let centre = |a: f64, b: f64| {
-            let (a, b) = (a.max(dlo), b.min(dhi));
-            if a <= b {
-                0.5 * (a + b)
-            } else {
-                scale.centre
-            }
-        };
-        let sf = |c: f64| [c, h, 0.0, 0.0];
-        let u = |c: f64| [(c - l.m1) / l.s1, h / l.s1, 0.0, 0.0];
-        let w = |c: f64| [(c - l.m2) / l.s2, h / l.s2, 0.0, 0.0];
-        // Pieces: sf < k1 quadratic; k1 ≤ sf ≤ k2 cubic; above both, the cubic at k2.
-        let cb = centre(f64::NEG_INFINITY, k1);
-        let below = sums.range(KeyRange::below(k1, false), cb);
-        let mut cols = [[0.0; 4]; 7];
-        let off = self.below_polys(&l, p, &u(cb), &sf(cb), &mut cols);
-        add_piece(&mut ne, &below, &cols[..nb], &off);
-        let plateau = if k1 <= k2 {
-            let cm = centre(k1, k2);
-            let middle = sums.range(KeyRange::closed(k1, k2), cm);
-            let mut cols = [[0.0; 4]; 7];
-            let off = self.upper_polys(&l, p, &w(cm), &sf(cm), &mut cols);
-            add_piece(&mut ne, &middle, &cols[..nb], &off);
-            sums.range(KeyRange::above(k2, false), scale.centre)
-        } else {
-            sums.range(KeyRange::above(k1, true), scale.centre)
-        };
-        if plateau[0] != 0.0 {
-            let mut cols = [[0.0; 4]; 7];
-            let wk = (k2 - l.m2) / l.s2;
-            let off = self.upper_polys(&l, p, &pc(wk), &pc(k2), &mut cols);
-            add_piece(&mut ne, &plateau, &cols[..nb], &off);
+        let window = ta <= tb && self.relaxes(i);
+        if !window {
+            return None;
         }
-        ne
+        let mut q = p.to_vec();
+        if i == 7 {
+            let below_k2 = tb <= k2;
+            if !below_k2 {
+                return None;
+            }
+            q[7] = ta;
+            return Some(FREE.equations(&q, free, scale, sums, true));
+        }
+        let above_k1 = k1 < ta && tb.is_finite();
+        if !above_k1 {
+            return None;
+        }
+        q[8] = ta;
+        let inner = self.equations(&q, free, scale, sums, false);
+        let f = sums.range(KeyRange::above(tb, true), scale.centre);
+        let nb = inner.nb;
+        let mut ne = NormalEquations::zeros(nb + 1);
+        for a in 0..nb {
+            ne.xtx[a * (nb + 1)..a * (nb + 1) + nb]
+                .copy_from_slice(&inner.xtx[a * nb..(a + 1) * nb]);
+        }
+        ne.xty[..nb].copy_from_slice(&inner.xty);
+        ne.xtx[nb * (nb + 1) + nb] = f[0];
+        ne.xty[nb] = f[feat::Y];
+        ne.yty = inner.yty + f[feat::YY];
+        Some(ne)
     }
     fn plan_sorted(&self, d: DistinctKeys) -> Plan {
         let p = published();

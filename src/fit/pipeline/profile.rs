@@ -17,7 +17,13 @@
 //! # Searches
 //! - A breakpoint whose residual sum of squares varies continuously (a plateau onset, a knot
 //!   with continuity) is minimised by a 64-cell grid scan followed by argmin's Brent method
-//!   ([`minimize_1d`]), on all rows.
+//!   ([`minimize_1d`]), on all rows. When the form relaxes the breakpoint over a window of
+//!   values ([`SortedProfile::window_relaxation`](crate::fit::forms::SortedProfile::window_relaxation):
+//!   the rows whose piece depends on where in the window the breakpoint lies dropped, the
+//!   model widened to contain every fit with the breakpoint in the window), the relaxed fit's
+//!   RSS bounds the profile from below on the whole window, and the grid scan is a branch and
+//!   bound ([`minimize_1d_bounded`]): windows whose bound exceeds the best grid value found are
+//!   never evaluated. The grid's first minimum, hence the result, is the scan's, bit for bit.
 //! - A *discrete* breakpoint ([`SortedProfile::discrete_breakpoint`]: the model depends on it
 //!   only through which rows fall on each side, e.g. the knot between the flight-time paper's
 //!   free pieces) has a step-function profile: any value between two adjacent distinct keys
@@ -38,9 +44,11 @@
 //! partition better than the incumbent by less than 1e-12 of it is not distinguishable, and
 //! which of two such near-ties is reported may depend on the visit order.
 use super::Prepared;
+use crate::fit::design::solve_normal;
 use crate::fit::design::{solve_rows, Layout};
 use crate::fit::forms::{DistinctKeys, Fitting};
-use crate::fit::nonlinear::minimize_1d;
+use crate::fit::nonlinear::{minimize_1d, minimize_1d_bounded};
+use crate::fit::prec::PROFILE_BOUND_SLACK;
 use crate::fit::record::BreakpointRecord;
 use crate::fit::FitError;
 use crate::relations::{Observation, ParamKind, Relation};
@@ -113,6 +121,55 @@ impl Profiler<'_> {
         let mut q = p.to_vec();
         q[i] = t;
         self.rss(&q)
+    }
+
+    /// True when the form bounds breakpoint `i`'s profile over windows
+    /// ([`SortedProfile::window_relaxation`](crate::fit::forms::SortedProfile::window_relaxation))
+    /// and the rows are summed from trees without a per-subject column.
+    fn bounds(&self, i: usize) -> bool {
+        matches!(self.src, Source::Sorted { sr, .. } if sr.ctx.form.relaxes(i))
+            && self.lay.subj_col.is_none()
+    }
+
+    /// `yᵀWy` of the normal equations at `p` (the scale of the profile's rounding).
+    fn yty(&self, p: &[f64]) -> f64 {
+        match self.src {
+            Source::Sorted { sr, members, .. } => {
+                let q = Query {
+                    sr,
+                    members,
+                    remove: None,
+                };
+                let ne = sr
+                    .ctx
+                    .form
+                    .normal_equations(p, &self.lay.free, &sr.ctx.scale, &q);
+                ne.yty
+            }
+            _ => f64::NAN,
+        }
+    }
+
+    /// A lower bound of the profile RSS of breakpoint `i` (the others at `p`) at every value in
+    /// `[ta, tb]`, allowing for rounding: the form's relaxed fit on the rows outside `[ta, tb)`
+    /// minus [`PROFILE_BOUND_SLACK`]·max(`yty`, that RSS) (`yty` from [`Self::yty`]); −∞ when
+    /// there is none.
+    fn window_bound(&self, p: &[f64], i: usize, ta: f64, tb: f64, yty: f64) -> f64 {
+        let Source::Sorted { sr, members, .. } = self.src else {
+            return f64::NEG_INFINITY;
+        };
+        let q = Query {
+            sr,
+            members,
+            remove: Some((ta, tb)),
+        };
+        sr.ctx
+            .form
+            .window_relaxation(p, &self.lay.free, i, ta, tb, &sr.ctx.scale, &q)
+            .and_then(|ne| solve_normal(ne.nb, &ne.xtx, &ne.xty, ne.yty))
+            .map_or(f64::NEG_INFINITY, |(_, rss)| {
+                rss - PROFILE_BOUND_SLACK * yty.max(rss)
+            })
     }
 
     /// The sorted source when breakpoint `i` is discrete.
@@ -320,6 +377,7 @@ pub(super) fn profile(
     let max_rounds = if bps.len() > 1 { 4 } else { 1 };
     // Per breakpoint: the parameters its last search saw, and its result.
     let mut last: Vec<Option<(Vec<f64>, f64)>> = vec![None; bps.len()];
+    let mut yty: Option<f64> = None;
     let same_but = |i: usize, a: &[f64], b: &[f64]| {
         a.iter()
             .zip(b)
@@ -347,7 +405,14 @@ pub(super) fn profile(
                     }
                     None => {
                         let tol = (hi - lo).abs() * 1e-7;
-                        minimize_1d(|t| pr.rss_at(&p, i, t), lo, hi, tol)?.0
+                        let f = |t| pr.rss_at(&p, i, t);
+                        if pr.bounds(i) {
+                            let yty = *yty.get_or_insert_with(|| pr.yty(&p));
+                            let lower = |a, b| pr.window_bound(&p, i, a, b, yty);
+                            minimize_1d_bounded(f, lower, p[i], lo, hi, tol)?.0
+                        } else {
+                            minimize_1d(f, lo, hi, tol)?.0
+                        }
                     }
                 },
             };
@@ -821,5 +886,113 @@ mod tests {
             assert_eq!(t.to_bits(), d.value(global).to_bits(), "start {start}");
             assert!(notes.is_empty());
         }
+    }
+
+    /// The continuous variant's k1 (k2 beyond the data) and k2 (k1 held) on [`two_jumps`]: the
+    /// bounded grid search returns the plain scan's result bit for bit from any warm start, its
+    /// window bounds never exceed the profile inside the window, and it evaluates fewer points.
+    #[test]
+    fn the_bounded_scan_of_a_continuous_knot_is_the_plain_scan_bit_for_bit() {
+        use crate::fit::nonlinear::minimize_1d_grid;
+        use std::cell::Cell;
+        let continuous = RunTflightSf::published_continuous();
+        let rel: &dyn Relation = &continuous;
+        let prep = two_jumps();
+        let form = rel.sorted_profile().expect("sorted form");
+        let sr = SortedRows::new(form, &prep, true);
+        let keys = sr.distinct_keys(&[true; 3]);
+        let lay = Layout::new(rel, vec![true; 9], 3);
+        let pr = Profiler {
+            rel,
+            lay: &lay,
+            src: Source::Sorted {
+                sr: &sr,
+                members: Members::All,
+                keys: DistinctKeys::new(&keys),
+            },
+        };
+        let n = keys.len();
+        let mut p = continuous.coefficients().to_vec();
+        // (breakpoint, the other knot, search range)
+        let cases = [
+            (7, 250.0, (keys[4], keys[n - 5])),
+            (8, 160.0, (keys[n / 8], keys[n - 4])),
+        ];
+        let mut irregular = 0;
+        for (i, other, (lo, hi)) in cases {
+            // The other knot: k2 for k1's profile, k1 for k2's.
+            p[if i == 7 { 8 } else { 7 }] = other;
+            assert!(pr.bounds(i));
+            let yty = pr.yty(&p);
+            let xs = minimize_1d_grid(lo, hi);
+            let f: Vec<f64> = xs.iter().map(|&t| pr.rss_at(&p, i, t)).collect();
+            let first = (0..f.len())
+                .min_by(|&a, &b| f[a].total_cmp(&f[b]))
+                .expect("grid");
+            // The bounds hold inside every window of 1, 2, 5 and 16 cells.
+            for w in [1, 2, 5, 16] {
+                for a in (0..xs.len() - w).step_by(3) {
+                    let lb = pr.window_bound(&p, i, xs[a], xs[a + w], yty);
+                    for q in 0..=16 {
+                        let t = xs[a] + (xs[a + w] - xs[a]) * q as f64 / 16.0;
+                        let r = pr.rss_at(&p, i, t);
+                        assert!(lb <= r, "k{}: window {a}+{w}, t {t}: {lb} > {r}", i - 6);
+                    }
+                }
+            }
+            // Grid local minima other than the first minimum: a descent to the better neighbour
+            // from one of them would stop there.
+            let local: Vec<usize> = (1..f.len() - 1)
+                .filter(|&k| k != first && f[k - 1] > f[k] && f[k + 1] >= f[k])
+                .collect();
+            irregular += local.len();
+            let tol = (hi - lo) * 1e-7;
+            let plain_evals = Cell::new(0usize);
+            let plain = minimize_1d(
+                |t| {
+                    plain_evals.set(plain_evals.get() + 1);
+                    pr.rss_at(&p, i, t)
+                },
+                lo,
+                hi,
+                tol,
+            )
+            .expect("scan");
+            let starts =
+                local
+                    .iter()
+                    .map(|&k| xs[k])
+                    .chain([lo, hi, xs[first], 0.5 * (lo + hi), f64::NAN]);
+            for warm in starts {
+                let evals = Cell::new(0usize);
+                let g = |t| {
+                    evals.set(evals.get() + 1);
+                    pr.rss_at(&p, i, t)
+                };
+                let lower = |a, b| pr.window_bound(&p, i, a, b, yty);
+                let bounded = minimize_1d_bounded(g, lower, warm, lo, hi, tol).expect("bounded");
+                assert_eq!(
+                    bounded.0.to_bits(),
+                    plain.0.to_bits(),
+                    "k{}, warm {warm}",
+                    i - 6
+                );
+                assert_eq!(
+                    bounded.1.to_bits(),
+                    plain.1.to_bits(),
+                    "k{}, warm {warm}",
+                    i - 6
+                );
+                assert!(
+                    evals.get() < plain_evals.get(),
+                    "k{}: nothing pruned",
+                    i - 6
+                );
+            }
+        }
+        assert!(
+            irregular > 0,
+            "no local minimum besides the first: not a test of the bound"
+        );
     }
 }
