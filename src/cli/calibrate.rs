@@ -41,7 +41,7 @@ pub struct Args {
     /// `paper` (W's rigid drawing, eqs. 11–12, 25–48) or `carried` (the subject's measured
     /// hip/knee/ankle curves kept in W: the paper's feet, the hip placed where the drawn angles
     /// come nearest them). Default `carried`: in the leave-one-out across the Schreiber subjects
-    /// it is nearer the held-out subjects' hip/knee/ankle angles than `paper` (4.8/7.7/6.7°
+    /// it is nearer the held-out subjects' hip/knee/ankle angles than `paper` (4.7/7.6/6.5°
     /// against 9.0/16.1/8.1°, tests/kb_carried.rs).
     #[arg(
         long = "kb-variant",

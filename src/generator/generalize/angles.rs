@@ -31,6 +31,11 @@ pub struct Angles {
     pub ankle: Vec<f64>,
     /// Swing ankle relative to its landing position ([`SAMPLES`] points, m).
     pub ankle_path: Vec<[f64; 2]>,
+    /// Of a measured stride whose pelvis is measured: the leg's hip joint centre relative to the
+    /// pelvis centre (forward, up; m), stance step then swing step (2·[`SAMPLES`]) — the
+    /// pelvis' rotation and list ([`super::prototype::SagittalLeg::hip_offset`]). Empty when not
+    /// measured and for drawn candidates.
+    pub hip_offset: Vec<[f64; 2]>,
 }
 
 /// Thigh, knee and ankle angles (rad, definitions above) of a leg from its hip, knee and ankle
@@ -53,6 +58,7 @@ fn empty() -> Angles {
         knee: Vec::with_capacity(2 * SAMPLES),
         ankle: Vec::with_capacity(2 * SAMPLES),
         ankle_path: Vec::with_capacity(SAMPLES),
+        hip_offset: Vec::new(),
     }
 }
 
@@ -116,6 +122,15 @@ pub fn measured_angles(
     }
     for i in 0..SAMPLES {
         push(&mut a, angles_at(ev.heel_strike + tau * (1.0 + grid(i))));
+    }
+    if let Some(d) = &leg.hip_offset {
+        // The same instants as the angles: stance step, then swing step.
+        for half in [0.0, 1.0] {
+            for i in 0..SAMPLES {
+                a.hip_offset
+                    .push(at(d, ev.heel_strike + tau * (half + grid(i))));
+            }
+        }
     }
     let land = at(&leg.ankle, ev.next_heel_strike);
     for i in 0..SAMPLES {

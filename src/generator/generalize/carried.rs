@@ -10,9 +10,14 @@
 //!   pivots and the swing ankle follows A, exactly as [`super::pose::pose`] draws them; nothing
 //!   here moves a foot, so the stance foot neither slides nor penetrates and steps chain as in
 //!   the paper;
-//! - **the hip (pelvis) the free variable**: with the pelvis upright, each leg's thigh, knee and
-//!   ankle angles follow from the hip position (two-link IK to its fixed ankle, knee forward; the
-//!   ankle angle from the foot's angle). The hip is the least-squares point
+//! - **the hip (pelvis) the free variable**: each leg's thigh, knee and ankle angles follow from
+//!   the pelvis centre's position (two-link IK from the leg's hip joint to its fixed ankle, knee
+//!   forward; the thigh angle read from the pelvis centre, as the measured one is; the ankle
+//!   angle from the foot's angle). When the prototype's pelvis was measured, W also carries its
+//!   rotation and list seen from the side — each hip joint's offset from the pelvis centre
+//!   ([`Carried::with_hip_offset`]) — and the stance leg hangs from the centre plus that offset,
+//!   the swing leg from the centre minus it, scaled as W's hip travel is
+//!   ([`Carried::hip_offset_at`]); without it both legs hang from one hip point. The hip is the least-squares point
 //!   min over h of Σ_legs Σ_{hip,knee,ankle} (drawn(h) − carried)², the carried curves read at the
 //!   same normalized step time (φ and ψ keep the moments FGM, MOM, TOM, so they need no
 //!   re-timing). The three angles weigh equally in radians: the comparison scores each angle's
@@ -29,6 +34,12 @@
 //! measured-minus-rendered residual; it carried φ's change of the rendered angles (eq. 27 pins
 //! the hip heights and bends the mid-stance knee of longer steps more than subjects do) and
 //! scored 6.2 / 10.2 / 6.8° against these curves' 4.8 / 7.7 / 6.7° (`tests/kb_carried.rs`).
+//!
+//! Two hip joints (session 7): on the Schreiber subjects the Harrington hip joint centres sit
+//! only ≈ 5 mm ahead of / behind the pelvis centre at heel strike (≈ 1.5 % of the step), so the
+//! pelvis takes little of a longer step: leave-one-out 4.7 / 7.6 / 6.5° against one hip point's
+//! 4.8 / 7.7 / 6.7° (naive scaling 5.3 / 7.7 / 5.7°); the drawn shank at heel strike still
+//! responds ≈ 39° per unit of step length / leg length against the subjects' ≈ 16°.
 use super::angles::{angles_from_poses, leg_angles, Angles, SAMPLES};
 use super::geometry::{knee_position, P2};
 use super::mu::MuFunctions;
@@ -43,17 +54,140 @@ pub struct Carried {
     hip: Vec<f64>,
     knee: Vec<f64>,
     ankle: Vec<f64>,
+    pelvis: Option<PelvisOffset>,
+}
+
+/// The prototype's pelvis rotation and list seen from the side: the stance leg's hip joint
+/// centre relative to the pelvis centre over the step ([`SAMPLES`] points, forward and up, m;
+/// the swing leg's is its negative), with the step length and leg length it was measured at.
+#[derive(Debug, Clone, PartialEq)]
+struct PelvisOffset {
+    stance: Vec<[f64; 2]>,
+    step_length: f64,
+    leg_length: f64,
 }
 
 impl Carried {
     /// The curves of `measured` (a prototype's measured stride angles; the ankle path is not
-    /// used).
-    pub fn from_measured(measured: &Angles) -> Result<Carried, GenerateError> {
-        Carried::from_curves(
+    /// used), and — when the stride's pelvis was measured (`measured.hip_offset`) — its hip
+    /// joints' offsets from the pelvis centre, for the step W `prototype` built from it.
+    pub fn from_measured(
+        measured: &Angles,
+        prototype: &WalkData,
+    ) -> Result<Carried, GenerateError> {
+        let c = Carried::from_curves(
             measured.hip.clone(),
             measured.knee.clone(),
             measured.ankle.clone(),
+        )?;
+        if measured.hip_offset.is_empty() {
+            return Ok(c);
+        }
+        c.with_hip_offset(
+            &measured.hip_offset,
+            prototype.step_length(),
+            prototype.body().leg_length(),
         )
+    }
+
+    /// Adds the pelvis: `stride` is one leg's hip joint centre relative to the pelvis centre
+    /// (forward, up; m) over its stride (2·[`SAMPLES`] points: stance step, then swing step),
+    /// measured at step length `step_length` with leg length `leg_length`.
+    ///
+    /// Walking symmetrically, the other leg's hip is the mirror (−offset), so one step's stance
+    /// hip offset is the mean of this leg's in its stance step and the negative of this leg's in
+    /// its swing step; the two instants a stride measures twice are averaged first (as
+    /// [`Carried::from_curves`] does), so the stance hip's offset at the step's end is minus its
+    /// start and the hips join across steps.
+    pub fn with_hip_offset(
+        mut self,
+        stride: &[[f64; 2]],
+        step_length: f64,
+        leg_length: f64,
+    ) -> Result<Carried, GenerateError> {
+        if stride.len() != 2 * SAMPLES {
+            return Err(GenerateError::Parameter {
+                name: "carried hip offset".into(),
+                value: stride.len() as f64,
+                message: format!("needs {} samples (stance and swing step)", 2 * SAMPLES),
+            });
+        }
+        if let Some(i) = stride
+            .iter()
+            .position(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(GenerateError::Parameter {
+                name: "carried hip offset".into(),
+                value: f64::NAN,
+                message: format!("sample {i} is not finite"),
+            });
+        }
+        for (name, v) in [("step length", step_length), ("leg length", leg_length)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(GenerateError::Parameter {
+                    name: format!("carried hip offset {name}"),
+                    value: v,
+                    message: "must be positive".into(),
+                });
+            }
+        }
+        let mut d = stride.to_vec();
+        for (a, b) in [(SAMPLES - 1, SAMPLES), (2 * SAMPLES - 1, 0)] {
+            let m = [0.5 * (d[a][0] + d[b][0]), 0.5 * (d[a][1] + d[b][1])];
+            d[a] = m;
+            d[b] = m;
+        }
+        let stance = (0..SAMPLES)
+            .map(|i| {
+                [
+                    0.5 * (d[i][0] - d[SAMPLES + i][0]),
+                    0.5 * (d[i][1] - d[SAMPLES + i][1]),
+                ]
+            })
+            .collect();
+        self.pelvis = Some(PelvisOffset {
+            stance,
+            step_length,
+            leg_length,
+        });
+        Ok(self)
+    }
+
+    /// The same curves without the pelvis offsets (one hip point for both legs, as before the
+    /// pelvis was carried).
+    pub fn without_hip_offset(mut self) -> Carried {
+        self.pelvis = None;
+        self
+    }
+
+    /// Whether the pelvis' rotation and list are carried.
+    pub fn has_hip_offset(&self) -> bool {
+        self.pelvis.is_some()
+    }
+
+    /// The stance leg's hip joint relative to the pelvis centre (forward, up; m) in the
+    /// generalized step `w` at normalized time `t` (the swing leg's is its negative); zero
+    /// without a carried pelvis.
+    ///
+    /// Scaled as W's own hip travel is scaled: forward by the step length over the prototype's
+    /// (ψ's α·x, eq. 43, and φ's ρ on the travel, eq. 26 — the pelvis keeps its share of the
+    /// step; across a change of step length the factor runs from sl_before at HSM⁻ to sl at
+    /// HSM⁺ so the hips join), up by the leg length over the prototype's (ψ's α·y, eq. 44; φ
+    /// leaves heights).
+    pub fn hip_offset_at(&self, w: &WalkData, t: f64) -> P2 {
+        let Some(p) = &self.pelvis else {
+            return [0.0, 0.0];
+        };
+        let t = t.clamp(0.0, 1.0);
+        let x = t * (SAMPLES - 1) as f64;
+        let i = (x.floor() as usize).min(SAMPLES - 2);
+        let f = x - i as f64;
+        let v = |k: usize| p.stance[i][k] + f * (p.stance[i + 1][k] - p.stance[i][k]);
+        let sl = (1.0 - t) * w.step_length_before() + t * w.step_length();
+        [
+            v(0) * sl / p.step_length,
+            v(1) * w.body().leg_length() / p.leg_length,
+        ]
     }
 
     /// Curves given directly (rad, 2·[`SAMPLES`] values each: stance step, then swing step).
@@ -90,7 +224,12 @@ impl Carried {
                 v[b] = m;
             }
         }
-        Ok(Carried { hip, knee, ankle })
+        Ok(Carried {
+            hip,
+            knee,
+            ankle,
+            pelvis: None,
+        })
     }
 
     /// The carried angles (hip, knee, ankle; rad) of the stance (`swing` false) or swing leg at
@@ -122,14 +261,22 @@ pub fn carried_pose(
     }
     let body = w.body();
     let (st, sw) = (p0.stance, p0.swing);
-    let draw = |h: P2, leg: &LegPose| {
-        let (k, _) = knee_position(body, h, leg.foot.ankle);
+    // Each leg hangs from its own hip joint: the pelvis centre h plus (stance) or minus (swing)
+    // the carried offset. The angles are read from the pelvis centre, as the measured ones are.
+    let off = carried.hip_offset_at(w, t);
+    let leg_hip = |h: P2, sign: f64| [h[0] + sign * off[0], h[1] + sign * off[1]];
+    let draw = |h: P2, leg: &LegPose, sign: f64| {
+        let (k, _) = knee_position(body, leg_hip(h, sign), leg.foot.ankle);
         leg_angles(h, k, leg.foot.ankle, leg.foot_angle)
     };
     let (ds, dw) = (carried.at(false, t), carried.at(true, t));
     let want = [ds[0], ds[1], ds[2], dw[0], dw[1], dw[2]];
     let reach = body.leg_length();
-    let ankles = [st.foot.ankle, sw.foot.ankle];
+    // Where the pelvis centre must be within reach of: each ankle shifted by its hip's offset.
+    let ankles = [
+        [st.foot.ankle[0] - off[0], st.foot.ankle[1] - off[1]],
+        [sw.foot.ankle[0] + off[0], sw.foot.ankle[1] + off[1]],
+    ];
     // Onto the reachable set: x within reach of both ankles, then the hip lowered under both
     // reach circles (lowering keeps a hip above its ankles within reach).
     let lo = ankles.iter().map(|a| a[0] - reach).fold(f64::MIN, f64::max);
@@ -143,7 +290,7 @@ pub fn carried_pose(
         [x, y]
     };
     let resid = |h: P2| -> [f64; 6] {
-        let (a, b) = (draw(h, &st), draw(h, &sw));
+        let (a, b) = (draw(h, &st, 1.0), draw(h, &sw, -1.0));
         let mut r = [0.0; 6];
         for j in 0..3 {
             r[j] = a[j] - want[j];
@@ -229,10 +376,11 @@ pub fn carried_pose(
             f = cost(&r);
         }
     }
-    let (k_st, _) = knee_position(body, h, st.foot.ankle);
-    let (k_sw, _) = knee_position(body, h, sw.foot.ankle);
+    let (k_st, _) = knee_position(body, leg_hip(h, 1.0), st.foot.ankle);
+    let (k_sw, _) = knee_position(body, leg_hip(h, -1.0), sw.foot.ankle);
     Ok(StepPose {
         hip: h,
+        hip_offset: off,
         stance: LegPose { knee: k_st, ..st },
         swing: LegPose { knee: k_sw, ..sw },
         ..p0
@@ -292,7 +440,7 @@ mod tests {
         for seed in 0..6 {
             let (w, mu) = synthetic_walk(seed).unwrap();
             let paper = super::super::angles::model_angles(&w, &mu).unwrap();
-            let c = carried_angles(&w, &mu, &Carried::from_measured(&paper).unwrap()).unwrap();
+            let c = carried_angles(&w, &mu, &Carried::from_measured(&paper, &w).unwrap()).unwrap();
             for (a, b) in paper.knee.iter().zip(&c.knee) {
                 assert!((a - b).abs() < 1e-9, "seed {seed}: {a} vs {b}");
             }
@@ -337,6 +485,113 @@ mod tests {
                     assert!((shin - body.shin()).abs() < 1e-9);
                 }
             }
+        }
+    }
+
+    /// A stride offset: the stance step's hip `c` ahead/up, the swing step's the mirror.
+    fn mirrored_offset(c: P2) -> Vec<P2> {
+        let mut v = vec![c; SAMPLES];
+        v.extend(vec![[-c[0], -c[1]]; SAMPLES]);
+        v
+    }
+
+    /// With the pelvis carried, each leg hangs from its own hip joint (centre ± offset, rigid
+    /// thigh and shin), the feet stay the paper's, and a posture drawn with a known pelvis centre
+    /// is found again — the angles read from the pelvis centre, as the measured ones are.
+    #[test]
+    fn a_carried_pelvis_hangs_each_leg_from_its_own_hip() {
+        for seed in 0..6 {
+            let (w, mu) = synthetic_walk(seed).unwrap();
+            let body = w.body();
+            let off = [0.012, -0.004];
+            for &t in &[0.3, 0.45, 0.6] {
+                let p0 = pose(&w, &mu, t).unwrap();
+                let target = [p0.hip[0] + 0.01, p0.hip[1] - 0.02];
+                let draw = |sign: f64, leg: &LegPose| {
+                    let hip = [target[0] + sign * off[0], target[1] + sign * off[1]];
+                    let (k, _) = knee_position(body, hip, leg.foot.ankle);
+                    leg_angles(target, k, leg.foot.ankle, leg.foot_angle)
+                };
+                let (a1, b1) = (draw(1.0, &p0.stance), draw(-1.0, &p0.swing));
+                let mk = |j: usize| -> Vec<f64> {
+                    let mut v = vec![a1[j]; SAMPLES];
+                    v.extend(vec![b1[j]; SAMPLES]);
+                    v
+                };
+                let c = Carried::from_curves(mk(0), mk(1), mk(2))
+                    .unwrap()
+                    .with_hip_offset(&mirrored_offset(off), w.step_length(), body.leg_length())
+                    .unwrap();
+                let near =
+                    |a: P2, b: P2| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+                assert!(near(c.hip_offset_at(&w, t), off));
+                let p = carried_pose(&w, &mu, t, &c).unwrap();
+                assert!(
+                    (p.hip[0] - target[0]).hypot(p.hip[1] - target[1]) < 1e-6,
+                    "seed {seed} t {t}: {:?} vs {target:?}",
+                    p.hip
+                );
+                assert!(near(p.hip_offset, off), "{:?}", p.hip_offset);
+                assert_eq!(p.stance.foot, p0.stance.foot);
+                assert_eq!(p.swing.foot, p0.swing.foot);
+                for (sign, leg) in [(1.0, &p.stance), (-1.0, &p.swing)] {
+                    let hip = [p.hip[0] + sign * off[0], p.hip[1] + sign * off[1]];
+                    let thigh = (leg.knee[0] - hip[0]).hypot(leg.knee[1] - hip[1]);
+                    let shin =
+                        (leg.knee[0] - leg.foot.ankle[0]).hypot(leg.knee[1] - leg.foot.ankle[1]);
+                    assert!((thigh - body.thigh()).abs() < 1e-9, "{thigh}");
+                    assert!((shin - body.shin()).abs() < 1e-9, "{shin}");
+                }
+                // Without the pelvis the same curves draw another pelvis centre.
+                let q = carried_pose(&w, &mu, t, &c.clone().without_hip_offset()).unwrap();
+                assert_eq!(q.hip_offset, [0.0, 0.0]);
+                assert!((q.hip[0] - p.hip[0]).hypot(q.hip[1] - p.hip[1]) > 1e-4);
+            }
+        }
+    }
+
+    /// The offsets scale as W's hip travel does (forward with the step length, up with the leg
+    /// length), and the stance hip's offset at a step's end is minus the next step's start (the
+    /// hips join across steps of different lengths).
+    #[test]
+    fn the_pelvis_offset_scales_with_the_step_and_joins_across_steps() {
+        let (w, mu) = synthetic_walk(3).unwrap();
+        let g = super::super::Generalizer::new(w.clone(), mu).unwrap();
+        // A stride whose halves differ and whose ends do not quite match (as measured ones).
+        let stride: Vec<P2> = (0..2 * SAMPLES)
+            .map(|i| {
+                let s = i as f64 / (2 * SAMPLES - 1) as f64;
+                let a = 2.0 * std::f64::consts::PI * s;
+                [0.01 * a.cos() + 0.001 * s, 0.006 * (2.0 * a).sin() + 0.0005]
+            })
+            .collect();
+        let c = Carried::from_measured(&super::super::angles::model_angles(&w, &mu).unwrap(), &w)
+            .unwrap()
+            .with_hip_offset(&stride, w.step_length(), w.body().leg_length())
+            .unwrap();
+        let e0 = c.hip_offset_at(&w, 0.0);
+        let e1 = c.hip_offset_at(&w, 1.0);
+        assert!((e0[0] + e1[0]).abs() < 1e-15 && (e0[1] + e1[1]).abs() < 1e-15);
+        let body = w.body().scaled(1.1).unwrap();
+        let lengths = [
+            w.step_length(),
+            1.2 * w.step_length(),
+            0.9 * w.step_length(),
+        ];
+        let steps = g.chain(&body, &lengths).unwrap();
+        for k in 1..steps.len() {
+            let a = c.hip_offset_at(&steps[k - 1], 1.0);
+            let b = c.hip_offset_at(&steps[k], 0.0);
+            assert!((a[0] + b[0]).abs() < 1e-12 && (a[1] + b[1]).abs() < 1e-12);
+        }
+        for &t in &[0.0, 0.3, 0.7, 1.0] {
+            let e = c.hip_offset_at(&w, t);
+            let f = c.hip_offset_at(&steps[1], t);
+            // Step 1 runs from sl_before = sl* to 1.2·sl*; the body is 1.1 times the prototype's.
+            let want_x = e[0] * (1.0 - t + t * 1.2);
+            let want_y = e[1] * body.leg_length() / w.body().leg_length();
+            assert!((f[0] - want_x).abs() < 1e-12, "t {t}: {} vs {want_x}", f[0]);
+            assert!((f[1] - want_y).abs() < 1e-12, "t {t}: {} vs {want_y}", f[1]);
         }
     }
 }

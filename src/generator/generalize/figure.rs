@@ -163,13 +163,39 @@ fn figure_pose(
     half_width: f64,
 ) -> (Pose, f64) {
     let mut pose = Pose::identity_at(DVec3::new(p.hip[0] + x0, p.hip[1], 0.0));
+    let [ex, ey] = p.hip_offset;
+    if (ex != 0.0 || ey != 0.0) && half_width > 0.0 {
+        // The carried pelvis: turned about the vertical and listed about the forward axis so
+        // the stance hip joint sits `hip_offset` ahead of / above the centre (and the swing hip
+        // as far behind / below), the trunk kept upright.
+        let z = match stance {
+            Side::Left => -half_width,
+            Side::Right => half_width,
+        };
+        let list = (-ey / z).clamp(-1.0, 1.0).asin();
+        let turn = (ex / (z * list.cos())).clamp(-1.0, 1.0).asin();
+        pose.set_world_rotation(
+            Joint::Pelvis,
+            DQuat::from_rotation_y(turn) * DQuat::from_rotation_x(list),
+        );
+        pose.set_world_rotation(Joint::Lumbar, DQuat::IDENTITY);
+    }
     let mut mismatch: f64 = 0.0;
     for (side, leg) in [(stance, &p.stance), (stance.opposite(), &p.swing)] {
         let z = match side {
             Side::Left => -half_width,
             Side::Right => half_width,
         };
-        let [_, _, ankle_j, mtp_j] = Joint::leg(side);
+        let [hip_j, _, ankle_j, mtp_j] = Joint::leg(side);
+        // The leg in the sagittal plane through its hip joint (a turned / listed pelvis brings
+        // the hip joints in by half the hip width times 1 − cos(turn)·cos(list): ≈ 0.15 mm for
+        // the Schreiber subjects' 5 mm offsets), so the drawn sagittal geometry is exactly the
+        // generalization's.
+        let z = if p.hip_offset == [0.0, 0.0] {
+            z
+        } else {
+            skeleton.joint_world(&pose, hip_j).1.z
+        };
         let target = DVec3::new(leg.foot.ankle[0] + x0, leg.foot.ankle[1], z);
         leg_ik(skeleton, &mut pose, side, target, DVec3::X);
         pose.set_world_rotation(ankle_j, DQuat::from_rotation_z(leg.foot_angle));

@@ -37,8 +37,13 @@ pub struct LegPose {
 pub struct StepPose {
     /// Normalized step time.
     pub t: f64,
-    /// Hip joint (both hips in the sagittal plane), after any lowering.
+    /// Hip joint (both hips in the sagittal plane), after any lowering; with a carried pelvis
+    /// ([`super::carried`]) the pelvis centre, the legs' hip joints at ± `hip_offset`.
     pub hip: P2,
+    /// The stance leg's hip joint relative to `hip` (forward, up; m), the swing leg's being its
+    /// negative: the pelvis' rotation and list the carried variant keeps; zero in the paper's
+    /// drawing (one hip point).
+    pub hip_offset: P2,
     /// The stance leg (heel strike at HSM⁻ of this step).
     pub stance: LegPose,
     /// The swing leg.
@@ -120,6 +125,7 @@ pub fn pose(w: &WalkData, mu: &MuFunctions, t: f64) -> Result<StepPose, Generate
     Ok(StepPose {
         t,
         hip,
+        hip_offset: [0.0, 0.0],
         stance: LegPose {
             knee: k_st,
             foot: stance_foot,

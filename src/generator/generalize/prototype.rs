@@ -70,6 +70,13 @@ pub struct SagittalLeg {
     /// both hip joint centres; `None` estimates it from `hip` and its mirror half a stride
     /// later (Winter's table has one side only).
     pub pelvis: Option<Vec<[f64; 2]>>,
+    /// This leg's hip joint centre minus the pelvis centre (the midpoint of both hip joint
+    /// centres), sagittal (forward, up; m), when the pelvis is measured (e.g. from its four
+    /// markers, [`super::compare::hip_joint_centre`]): the pelvis' rotation (transverse) and
+    /// list seen from the side — how far each hip joint is ahead of / above the other's mean.
+    /// The carried variant places each leg's hip with it ([`super::carried`]); `None` when the
+    /// pelvis is not measured (Winter's table).
+    pub hip_offset: Option<Vec<[f64; 2]>>,
 }
 
 /// One stride's events of the leg, s: heel strike, toe off, next heel strike.
@@ -215,6 +222,7 @@ pub fn build_prototype(
         ("ball", &leg.ball),
         ("toe", &leg.toe),
         ("pelvis", leg.pelvis.as_ref().unwrap_or(&leg.hip)),
+        ("hip offset", leg.hip_offset.as_ref().unwrap_or(&leg.hip)),
     ] {
         if v.len() != n {
             return Err(err(
@@ -558,6 +566,7 @@ pub fn winter_leg(
         ball: get("RIGHT MT5")?,
         toe: get("RIGHT TOE")?,
         pelvis: None,
+        hip_offset: None,
     };
     let t = |frame: usize| -> Result<f64, GenerateError> {
         m.time_s.get(frame - 1).copied().ok_or_else(|| {
@@ -616,7 +625,10 @@ impl Prototype {
     /// The curves the carried variant keeps ([`Carried::from_measured`]); `None` without
     /// measured angles.
     pub fn carried(&self) -> Result<Option<Carried>, GenerateError> {
-        self.angles.as_ref().map(Carried::from_measured).transpose()
+        self.angles
+            .as_ref()
+            .map(|a| Carried::from_measured(a, &self.walk))
+            .transpose()
     }
 
     /// The prototype bundled with gaitfit: Winter's walk (`data/prototype_winter.json`).
@@ -702,16 +714,19 @@ impl Prototype {
                     || m.hip_rad.len() != n
                     || m.knee_rad.len() != n
                     || m.ankle_rad.len() != n
+                    || !(m.hip_offset_m.is_empty() || m.hip_offset_m.len() == n)
                 {
                     return Err(format!(
                         "{what}: measured_angles: samples_per_step must be {SAMPLES} and hip_rad, \
-                         knee_rad, ankle_rad hold {n} values each (stance step, then swing step)"
+                         knee_rad, ankle_rad (and hip_offset_m if given) hold {n} values each \
+                         (stance step, then swing step)"
                     ));
                 }
                 if m.hip_rad
                     .iter()
                     .chain(&m.knee_rad)
                     .chain(&m.ankle_rad)
+                    .chain(m.hip_offset_m.iter().flatten())
                     .any(|v| !v.is_finite())
                 {
                     return Err(format!("{what}: measured_angles: a value is not finite"));
@@ -721,6 +736,7 @@ impl Prototype {
                     knee: m.knee_rad,
                     ankle: m.ankle_rad,
                     ankle_path: Vec::new(),
+                    hip_offset: m.hip_offset_m,
                 })
             }
             None => None,
@@ -793,6 +809,7 @@ impl Prototype {
                 hip_rad: a.hip.clone(),
                 knee_rad: a.knee.clone(),
                 ankle_rad: a.ankle.clone(),
+                hip_offset_m: a.hip_offset.clone(),
             }),
         };
         // Serializing plain numbers and strings cannot fail.
@@ -846,6 +863,10 @@ struct MeasuredAnglesFile {
     hip_rad: Vec<f64>,
     knee_rad: Vec<f64>,
     ankle_rad: Vec<f64>,
+    /// The leg's hip joint centre relative to the pelvis centre (forward, up; m) at the same
+    /// samples, when the pelvis was measured.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    hip_offset_m: Vec<[f64; 2]>,
 }
 
 #[derive(Debug, serde::Serialize, serde::Deserialize)]
@@ -968,4 +989,28 @@ pub(crate) fn flat_foot_line(leg: &SagittalLeg, ev: &StrideEvents) -> f64 {
 /// Linear interpolation of a landmark at time `t` (clamped).
 pub(crate) fn landmark_at(leg: &SagittalLeg, v: &[[f64; 2]], t: f64) -> [f64; 2] {
     sample(&leg.time_s, v, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A measured pelvis (hip joint offsets) survives the prototype file, and a wrong count is
+    /// refused by name.
+    #[test]
+    fn the_hip_offset_round_trips_through_the_prototype_file() {
+        let mut p = Prototype::bundled();
+        let a = p.angles.as_mut().unwrap();
+        assert!(a.hip_offset.is_empty());
+        a.hip_offset = (0..2 * SAMPLES)
+            .map(|i| [0.001 * i as f64, -0.0005 * i as f64])
+            .collect();
+        let text = p.to_json("test", None);
+        let q = Prototype::from_json(&text, "t.json").unwrap();
+        assert_eq!(q.angles, p.angles);
+        assert!(q.carried().unwrap().unwrap().has_hip_offset());
+        let short = text.replacen("\"hip_offset_m\": [", "\"hip_offset_m\": [\n[0.0, 0.0],", 1);
+        let e = Prototype::from_json(&short, "t.json").unwrap_err();
+        assert!(e.contains("hip_offset_m"), "{e}");
+    }
 }
