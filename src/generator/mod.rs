@@ -3,6 +3,7 @@
 pub mod anthropometry;
 pub mod checks;
 pub mod curves;
+pub mod draw;
 pub mod generalize;
 pub mod ik;
 pub mod motion;
