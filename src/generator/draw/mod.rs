@@ -9,6 +9,8 @@
 //! - [`foot`]: the rolling foot as one roll coordinate about its heel, metatarsal joint and toe
 //!   tip, twice differentiable away from the flat foot, and the stance roll curve that is
 //!   exactly flat between foot flat and heel off and at rest at both ends of the flat foot.
+//! - [`feet`]: a foot's whole drawn path from sampled targets: contact runs rolling, flights
+//!   splined and corrected onto the rolling foot at both ends.
 //! - [`leg`]: the one soft two-link leg IK: the hip–ankle distance is softened near full
 //!   extension (C², straight only in the limit), then the rigid chain is solved inside its reach.
 //!
