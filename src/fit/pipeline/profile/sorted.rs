@@ -381,25 +381,43 @@ impl<'a> SortedRows<'a> {
         let mut keys = Vec::with_capacity(n);
         let mut rows = Vec::with_capacity(n);
         let mut key_subject = Vec::with_capacity(n);
-        // One gather of the rows into key order (a tight loop: many reads in flight), after
-        // which every tree reads them sequentially.
-        let data: Vec<Row> = order
+        // The rows are stored by subject, each subject's in key order: a subject's tree reads
+        // its rows (a query's edge rows, its leaves) from one contiguous block, and the prepared
+        // rows (grouped by subject as the tables list them) are read almost in order. The tree
+        // over all rows reaches them through its index, in key order. Which slot a row occupies
+        // changes no sum: every tree adds its rows in its own key order.
+        let mut next: Vec<usize> = count
             .iter()
-            .map(|&v| {
-                let i = ((v >> 32) as u32) as usize;
-                Row {
-                    obs: prep.obs[i],
-                    weight: prep.weights[i],
-                }
+            .scan(0usize, |acc, &c| {
+                let start = *acc;
+                *acc += c;
+                Some(start)
             })
             .collect();
-        for (j, &v) in order.iter().enumerate() {
-            let key = key_of(v);
+        let mut data: Vec<Row> = vec![
+            Row {
+                obs: Observation {
+                    x: Default::default(),
+                    y: 0.0,
+                },
+                weight: 0.0,
+            };
+            n
+        ];
+        for &v in &order {
+            let i = ((v >> 32) as u32) as usize;
             let s = (v as u32) as usize;
+            let slot = next[s];
+            next[s] += 1;
+            data[slot] = Row {
+                obs: prep.obs[i],
+                weight: prep.weights[i],
+            };
+            let key = key_of(v);
             per_keys[s].push(key);
-            per_rows[s].push(j as u32);
+            per_rows[s].push(slot as u32);
             keys.push(key);
-            rows.push(j as u32);
+            rows.push(slot as u32);
             key_subject.push(s as u32);
         }
         drop(order);
