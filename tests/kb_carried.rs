@@ -8,12 +8,13 @@
 //! taken from the comparison module. What is asserted is what holds: the carried variant is
 //! closer to the measured angles than the paper's on every joint, and keeps the paper's ankle
 //! path, clearly better than naive scaling. The goal, angles no worse than naive, is
-//! NOT met and is printed (the module docs of
-//! `generator::generalize::compare` say why). The carried strides keep their measured pelvis
+//! printed, not asserted (the module docs of `generator::generalize::compare` give the figures).
+//! The carried candidates use the heel-rise relation μ₅ with its slope fitted, in each fold, on
+//! the other subjects' strides only (`compare::fit_heel_rise_slope`); the fold slopes are printed. The carried strides keep their measured pelvis
 //! (each leg from its own hip joint); asserted below so the table is that variant's.
 use gaitfit::generator::generalize::compare::{
-    compare, generalize_onto, mean_scores, schreiber_strides_with, Landmarks, MeasuredStride,
-    Target,
+    compare, fit_heel_rise_slope, generalize_onto, mean_scores, schreiber_strides_with, Landmarks,
+    MeasuredStride, Target,
 };
 use gaitfit::generator::generalize::default_alpha;
 use gaitfit::shared_data;
@@ -71,6 +72,12 @@ fn carried_variant_against_paper_and_naive_scaling() {
         strides.iter().all(|s| !s.angles.hip_offset.is_empty()),
         "a Schreiber stride without its measured pelvis"
     );
+    let mut subjects: Vec<&str> = strides.iter().map(|s| s.subject.as_str()).collect();
+    subjects.dedup();
+    for subj in subjects {
+        let a5 = fit_heel_rise_slope(strides.iter().filter(|s| s.subject != subj));
+        println!("fold without {subj}: alpha5 = {a5:?} rad per unit sl/leg");
+    }
     let rows = compare(&strides, default_alpha(), Target::Measured);
     // A pair whose generalization fails (a μ out of its range) is left out of every column.
     let failures: Vec<&String> = rows.iter().flat_map(|r| &r.failures).collect();
@@ -81,15 +88,15 @@ fn carried_variant_against_paper_and_naive_scaling() {
     let (p, c) = (m.generalized_same, m.carried_same);
     println!("| variant | hip | knee | ankle (deg RMS) | ankle path (cm) |\n|---|---|---|---|---|");
     println!(
-        "| paper | {:.1} | {:.1} | {:.1} | {:.1} |",
+        "| paper | {:.2} | {:.2} | {:.2} | {:.2} |",
         p.hip_deg, p.knee_deg, p.ankle_deg, p.ankle_path_cm
     );
     println!(
-        "| carried | {:.1} | {:.1} | {:.1} | {:.1} |",
+        "| carried | {:.2} | {:.2} | {:.2} | {:.2} |",
         c.hip_deg, c.knee_deg, c.ankle_deg, c.ankle_path_cm
     );
     println!(
-        "| naive scaling | {:.1} | {:.1} | {:.1} | {:.1} |",
+        "| naive scaling | {:.2} | {:.2} | {:.2} | {:.2} |",
         naive[0], naive[1], naive[2], naive[3]
     );
     // The table's own naive column is the same quantity, computed by the module.

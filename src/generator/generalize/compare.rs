@@ -15,6 +15,8 @@
 //!   measured curves (on the same normalized step time: φ and ψ keep the moments). These are
 //!   the angles
 //!   `gaitfit generate generalize --kb-variant carried` draws; the ankle path is the paper's;
+//!   here the trailing foot's heel rise at HSM⁺ follows μ₅ ([`super::HeelRise`]) with α₅ fitted
+//!   on the fold's other subjects ([`fit_heel_rise_slope`]), which the CLI does not (yet) do;
 //! - **naive**: A's measured stride unchanged in angles and time-normalized, its ankle path
 //!   scaled by ll(B)/ll(A) (A's step scaled uniformly in size and time);
 //! - **naive rendered**: A's step W rendered through the same model, unchanged (uniform scaling
@@ -37,9 +39,10 @@
 //! with step length (≈ 3.5 / 4.5 / 4° between the two speeds), less than φ changes them.
 //!
 //! The carried variant (issue 21 item 5, `tests/kb_carried.rs`, lateral markers, 2026-12-07):
-//! hip / knee / ankle RMS 4.7 / 7.6 / 6.5° against the paper's 9.0 / 16.1 / 8.1° and naive
-//! scaling's 5.3 / 7.7 / 5.7°; ankle path 6.4 cm (the paper's) against naive's 9.0 cm: hip
-//! better than naive, knee equal, ankle 0.85° worse. With one hip point for both legs it was
+//! without the heel-rise relation μ₅: hip / knee / ankle RMS 4.7 / 7.6 / 6.5° against the
+//! paper's 9.0 / 16.1 / 8.1° and naive scaling's 5.3 / 7.7 / 5.7°; ankle path 6.4 cm (the
+//! paper's) against naive's 9.0 cm: hip better than naive, knee equal, ankle 0.85° worse (with
+//! μ₅, below: 4.74 / 7.58 / 5.60°). With one hip point for both legs it was
 //! 4.8 / 7.7 / 6.7°; each leg now hangs from its own hip joint, the pelvis' rotation and list
 //! carried from the Harrington joint centres ([`super::carried`]) — but they sit only ≈ 5 mm
 //! ahead of / behind the pelvis centre at heel strike (≈ 1.5 % of the step). The ankle's excess
@@ -50,7 +53,15 @@
 //! What holds the trailing leg back is its foot: at heel strike the subjects' trailing heel
 //! rise grows ≈ 91° per unit of step length / leg length (across subjects), the drawing's
 //! ≈ 19° — eq. 33 scales the whole F₂ by μ₃(sl)/μ₃*, so the heel rise at the other foot's heel
-//! strike moves only in proportion to the toe-off angle's relative change. Earlier carried designs, all worse: the
+//! strike moves only in proportion to the toe-off angle's relative change. The comparison's
+//! carried candidates therefore draw with the heel-rise relation μ₅ ([`super::HeelRise`]: the
+//! heel rise at HSM⁺ linear in sl/leg, μ₅* the source's own), its slope α₅ fitted in each
+//! leave-one-out fold by [`fit_heel_rise_slope`] on the other subjects' strides only (1.60 to
+//! 1.70 rad ≈ 92–98° per unit of sl/leg over the six folds): hip / knee / ankle 4.74 / 7.58 /
+//! 5.60° against naive's 5.28 / 7.67 / 5.66°, ankle path 6.35 vs 9.03 cm — the ankle from 6.51
+//! to 5.60°, the angles now no worse than naive scaling (the ankle by 0.06°, within the spread
+//! of one subject; the hip 0.05° worse than without μ₅). Calibrate's Ko–Badler stage has no
+//! training subjects and draws without μ₅. Earlier carried designs, all worse: the
 //! generalized step's rendering plus the prototype's measured-minus-rendered residual as the
 //! preferred posture (6.2 / 10.2 / 6.8°) or simply added to the rendered angles (not drawable —
 //! the feet would move; 6.1 / 10.6 / 6.5°) — both carry what φ changes in the rendered angles:
@@ -507,7 +518,54 @@ pub fn generalize_onto_with(
     alpha: [f64; 4],
     variant: Variant,
 ) -> Result<Angles, GenerateError> {
-    let mu = src.prototype.mu(alpha)?;
+    generalize_onto_heel(src, dst, alpha, variant, None)
+}
+
+/// The measured heel rise at the other foot's heel strike (−F₂ at HSM⁺, rad) and the step
+/// length per leg length of a stride's prototype: one sample of the relation μ₅
+/// ([`super::HeelRise`]).
+pub fn heel_rise_sample(s: &MeasuredStride) -> (f64, f64) {
+    let w = &s.prototype.walk;
+    (w.step_length() / w.body().leg_length(), -w.foot2().at(1.0))
+}
+
+/// α₅ of the heel-rise relation μ₅ ([`super::HeelRise`]): the ordinary least-squares slope of
+/// the heel rise at HSM⁺ on sl/ll over `training` (rad per unit of sl/ll, every stride one
+/// sample, pooled over subjects, speeds and legs); `None` with fewer than 3 samples or no spread
+/// of sl/ll. The leave-one-out of [`compare`] fits it on the other subjects' strides only.
+pub fn fit_heel_rise_slope<'a>(
+    training: impl IntoIterator<Item = &'a MeasuredStride>,
+) -> Option<f64> {
+    let xy: Vec<(f64, f64)> = training.into_iter().map(heel_rise_sample).collect();
+    let n = xy.len() as f64;
+    if xy.len() < 3 {
+        return None;
+    }
+    let (mx, my) = (
+        xy.iter().map(|p| p.0).sum::<f64>() / n,
+        xy.iter().map(|p| p.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = xy.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxy: f64 = xy.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    (sxx > 0.0 && (sxy / sxx).is_finite()).then(|| sxy / sxx)
+}
+
+/// [`generalize_onto_with`], with the heel-rise relation μ₅ of slope `heel_alpha` (rad per unit
+/// of sl/ll; μ₅* = `src`'s own heel rise at HSM⁺) when given — the paper's eq. 33 without.
+pub fn generalize_onto_heel(
+    src: &MeasuredStride,
+    dst: &MeasuredStride,
+    alpha: [f64; 4],
+    variant: Variant,
+    heel_alpha: Option<f64>,
+) -> Result<Angles, GenerateError> {
+    let mut mu = src.prototype.mu(alpha)?;
+    if let Some(a) = heel_alpha {
+        mu = mu.with_heel_rise(super::HeelRise {
+            alpha: a,
+            star: heel_rise_sample(src).1,
+        })?;
+    }
     let g = Generalizer::new(src.prototype.walk.clone(), mu)?;
     let w = psi(&src.prototype.walk, dst.prototype.walk.body(), &mu)?;
     let sl = dst.prototype.walk.step_length();
@@ -594,6 +652,8 @@ pub fn compare(strides: &[MeasuredStride], alpha: [f64; 4], target: Target) -> V
             failures: Vec::new(),
         };
         let (mut n_same, mut n_other) = (0.0, 0.0);
+        // μ₅'s slope from the training subjects of this fold only (never the target's subject).
+        let heel_alpha = fit_heel_rise_slope(strides.iter().filter(|s| s.subject != b.subject));
         for a in strides {
             if a.side != b.side {
                 continue;
@@ -616,7 +676,7 @@ pub fn compare(strides: &[MeasuredStride], alpha: [f64; 4], target: Target) -> V
                     let ns = Scores::of(&n, &b.angles);
                     if same {
                         row.generalized_same.add(&s);
-                        match generalize_onto_with(a, b, alpha, Variant::Carried) {
+                        match generalize_onto_heel(a, b, alpha, Variant::Carried, heel_alpha) {
                             Ok(c) => row.carried_same.add(&Scores::of(&c, &b.angles)),
                             Err(e) => row
                                 .failures

@@ -43,7 +43,7 @@ pub mod psi;
 pub mod synthetic;
 pub mod walk_data;
 
-pub use mu::{MuFunctions, MuValues};
+pub use mu::{HeelRise, MuFunctions, MuValues};
 pub use phi::{phi, phi_rho};
 pub use psi::psi;
 pub use walk_data::{AngleSequence, Anthropometry, Moments, PathSequence, TimedSequence, WalkData};

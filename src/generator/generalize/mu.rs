@@ -51,6 +51,27 @@ pub struct MuFunctions {
     mu_star: [f64; 4],
     sl_star: f64,
     ll_star: f64,
+    heel_rise: Option<HeelRise>,
+}
+
+/// An optional fifth μ-like relation, not in the paper: the stance foot's heel rise when the
+/// other foot strikes (−F₂ at HSM⁺ = t = 1 of the step, rad, positive),
+///
+/// ```text
+/// μ₅(S, sl) = μ₅* + α₅ (sl/ll(S) − sl*/ll(S*))
+/// ```
+///
+/// linear in the step length per leg length (α₅ in rad per unit of sl/ll; sl/ll(S) = x/ll(S*)
+/// for the corrected argument x, so μ₅ is a function of x like μ₁…μ₄ and keeps Theorems 1–5).
+/// With it φ scales F₂ by μ₅(sl)/μ₅* up to HSM⁺ and blends the scale linearly to eq. 33's
+/// μ₃(sl)/μ₃* at toe off ([`super::phi()`]); without it (the paper) eq. 33 scales all of F₂ by
+/// μ₃(sl)/μ₃*, so the heel rise at HSM⁺ follows only the toe-off angle's relative change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HeelRise {
+    /// α₅: rad per unit of step length / leg length.
+    pub alpha: f64,
+    /// μ₅*: the prototype's heel rise at HSM⁺ (rad, positive).
+    pub star: f64,
 }
 
 impl MuFunctions {
@@ -105,12 +126,69 @@ impl MuFunctions {
             mu_star,
             sl_star,
             ll_star,
+            heel_rise: None,
         })
+    }
+
+    /// The same μ-functions with the heel-rise relation μ₅ ([`HeelRise`]); errors unless α₅ is
+    /// finite and μ₅* positive (it scales F₂ multiplicatively).
+    pub fn with_heel_rise(&self, heel: HeelRise) -> Result<Self, GenerateError> {
+        if !heel.alpha.is_finite() {
+            return Err(GenerateError::Parameter {
+                name: "alpha5".into(),
+                value: heel.alpha,
+                message: "must be finite (rad per unit of sl/ll)".into(),
+            });
+        }
+        if !(heel.star.is_finite() && heel.star > 0.0) {
+            return Err(GenerateError::Parameter {
+                name: "mu5_star".into(),
+                value: heel.star,
+                message: "must be a positive angle (rad): the heel must be up at HSM+ to scale F2"
+                    .into(),
+            });
+        }
+        Ok(MuFunctions {
+            heel_rise: Some(heel),
+            ..*self
+        })
+    }
+
+    /// The heel-rise relation, if any (`None`: the paper's eq. 33).
+    pub fn heel_rise(&self) -> Option<HeelRise> {
+        self.heel_rise
+    }
+
+    /// μ₅(S, sl) ([`HeelRise`]), or `None` without the relation; errors when it is not positive.
+    pub fn heel_rise_at(
+        &self,
+        body: &Anthropometry,
+        step_length: f64,
+    ) -> Result<Option<f64>, GenerateError> {
+        let Some(h) = self.heel_rise else {
+            return Ok(None);
+        };
+        let x = self.argument(body.leg_length(), step_length);
+        let v = h.star + h.alpha * (x - self.sl_star) / self.ll_star;
+        if v.is_nan() || v <= 0.0 {
+            return Err(GenerateError::Parameter {
+                name: "step_length".into(),
+                value: step_length,
+                message: format!(
+                    "mu5 (heel rise at HSM+) = {v:.4} rad is not positive at this step length: \
+                     choose a step closer to the prototype's"
+                ),
+            });
+        }
+        Ok(Some(v))
     }
 
     /// The same prototype values with other slopes (validated).
     pub fn with_alpha(&self, alpha: [f64; 4]) -> Result<Self, GenerateError> {
-        MuFunctions::new(alpha, self.mu_star, self.sl_star, self.ll_star)
+        Ok(MuFunctions {
+            heel_rise: self.heel_rise,
+            ..MuFunctions::new(alpha, self.mu_star, self.sl_star, self.ll_star)?
+        })
     }
 
     /// α₁…α₄ (rad/m).
@@ -238,6 +316,52 @@ mod tests {
         let p = mu.argument_as_printed(b.leg_length(), 0.6);
         let p2 = mu.argument_as_printed(b2.leg_length(), 1.3 * 0.6);
         assert!((p2 / p - 1.69).abs() < 1e-9, "printed form scales with α²");
+    }
+
+    #[test]
+    fn heel_rise_is_linear_in_step_per_leg_length() {
+        let mu = MuFunctions::new([0.1, 0.2, 0.3, 0.4], [0.1, 0.4, 1.2, 1.0], 0.7, 0.74).unwrap();
+        assert_eq!(
+            mu.heel_rise_at(&body(1.0), 0.7).unwrap(),
+            None,
+            "paper: no μ5"
+        );
+        let h = mu
+            .with_heel_rise(HeelRise {
+                alpha: 1.5,
+                star: 0.3,
+            })
+            .unwrap();
+        let b = body(1.0);
+        let ll = b.leg_length();
+        // At the prototype's condition μ5 = μ5*; 0.074 m longer → +1.5 · 0.074 / ll(S*).
+        let at = |sl: f64| h.heel_rise_at(&b, sl).unwrap().unwrap();
+        assert!((at(0.7) - 0.3).abs() < 1e-15);
+        assert!(
+            (at(0.774) - (0.3 + 1.5 * 0.074 / ll)).abs() < 1e-12,
+            "ll = {ll}"
+        );
+        // Similarity invariant like μ1…μ4: the same sl/ll on a body 1.3 times larger.
+        let big = body(1.3);
+        let v = h.heel_rise_at(&big, 1.3 * 0.774).unwrap().unwrap();
+        assert!((v - at(0.774)).abs() < 1e-12);
+        assert!(h.heel_rise_at(&b, 0.3).is_err(), "μ5 through zero");
+        assert!(mu
+            .with_heel_rise(HeelRise {
+                alpha: 1.0,
+                star: 0.0
+            })
+            .is_err());
+        assert!(mu
+            .with_heel_rise(HeelRise {
+                alpha: f64::NAN,
+                star: 0.2
+            })
+            .is_err());
+        assert_eq!(
+            h.with_alpha([0.1, 0.2, 0.3, 0.5]).unwrap().heel_rise(),
+            h.heel_rise()
+        );
     }
 
     #[test]

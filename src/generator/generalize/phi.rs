@@ -11,6 +11,9 @@
 //! F₂: f'₂ᵢ = f₂ᵢ · (−μ₃(S, ρsl)) / f₂ₙ                                               (eq. 33)
 //! F₃: f'₃ᵢ = f₃ᵢ + (1 − t'ᵢ)d₁ + t'ᵢd₂, t'ᵢ = (t₃ᵢ − TOM)/(HSM⁺ − TOM)                (eq. 34 ★)
 //!     d₁ = −μ₃(S, sl'_before) − f₃₁ ★,  d₂ = μ₂(S, ρsl) − f₃ₙ
+//!     with the optional heel-rise relation μ₅ (not the paper's, [`super::mu::HeelRise`]):
+//!     f'₂ᵢ = f₂ᵢ · k(tᵢ), k = μ₅(S, ρsl)/(−f₂(1)) up to F₂'s first sample at or after HSM⁺
+//!     (t = 1), then blended linearly in t to eq. 33's (−μ₃(S, ρsl))/f₂ₙ at 1 + TOM
 //! M:  m'ᵢ = mᵢ · μ₄(S, ρsl) / mₙ                                                    (eq. 36)
 //! A:  x'ᵢ = b₃ₓ + (b₄ₓ − b₃ₓ)/(xₙ − x₁) · (xᵢ − x₁)                                  (eq. 39 ★)
 //!     y'ᵢ = yᵢ + (1 − t'ᵢ)d₁ + t'ᵢd₂, d₁ = b₃ᵧ − y₁, d₂ = b₄ᵧ − yₙ                    (eq. 40)
@@ -45,7 +48,7 @@
 //!   constraints instead of carrying its offsets along.
 use super::geometry::{foot_on_pivot, hip_height_for_knee, Pivot, P2};
 use super::mu::{MuFunctions, MuValues};
-use super::walk_data::{Anthropometry, PathSequence, WalkData};
+use super::walk_data::{AngleSequence, Anthropometry, PathSequence, WalkData};
 use crate::generator::GenerateError;
 
 /// The constrained end points of a step of `body` stepping `sl` after `sl_before`, with the hip
@@ -85,6 +88,24 @@ impl StepEnds {
             ankle_to,
             ankle_hs,
         })
+    }
+}
+
+/// Where F₂'s scale stands between the heel-rise scale (0) and eq. 33's (1) at time `t` with
+/// the heel-rise relation μ₅: 0 up to F₂'s first sample at or after HSM⁺ (so F₂ interpolated
+/// at t = 1 is exactly −μ₅), then linear in t to 1 at F₂'s end (1 + TOM).
+pub(crate) fn heel_blend(foot2: &AngleSequence, t: f64) -> f64 {
+    let tb = foot2
+        .times()
+        .iter()
+        .copied()
+        .find(|&x| x >= 1.0)
+        .unwrap_or(1.0);
+    let te = foot2.t_last();
+    if t <= tb || te <= tb {
+        0.0
+    } else {
+        ((t - tb) / (te - tb)).min(1.0)
     }
 }
 
@@ -164,7 +185,24 @@ pub fn phi(
     let k1 = ends.mu_before.foot_hs / w.foot1.first()[0];
     let foot1 = w.foot1.map(|_, [f]| [f * k1]);
     let k2 = -ends.mu.foot_to / w.foot2.last()[0];
-    let foot2 = w.foot2.map(|_, [f]| [f * k2]);
+    let foot2 = match mu.heel_rise_at(&body, sl)? {
+        None => w.foot2.map(|_, [f]| [f * k2]),
+        // μ₅ ([`super::mu::HeelRise`]): F₂ scaled to the heel rise μ₅(ρsl) on [FGM, HSM⁺], the
+        // scale blended linearly to eq. 33's on [HSM⁺, 1 + TOM] (both ends exact, F₂ continuous).
+        Some(h) => {
+            let h_w = -w.foot2.at(1.0);
+            if !(h_w.is_finite() && h_w > 0.0) {
+                return Err(GenerateError::Parameter {
+                    name: "F2(HSM+)".into(),
+                    value: h_w,
+                    message: "the heel must be up at HSM+ for the heel-rise relation mu5".into(),
+                });
+            }
+            let kh = h / h_w;
+            w.foot2
+                .map(|t, [f]| [f * ramp(heel_blend(&w.foot2, t), kh, k2)])
+        }
+    };
     let d1 = -ends.mu_before.foot_to - w.foot3.first()[0];
     let d2 = ends.mu.foot_hs - w.foot3.last()[0];
     let foot3 = w

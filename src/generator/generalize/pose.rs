@@ -6,7 +6,8 @@
 //!   rocker with M from MOM (pivots at x = 0, heel-to-ball, heel-to-toe: the foot cannot slide
 //!   or penetrate).
 //! - Swing foot: on [0, TOM] it is still finishing the previous step's stance — F₂ and M on
-//!   [1, 1 + TOM], rescaled from μ(ρsl) to μ(sl_before) (the previous step's own F₂ and M, since
+//!   [1, 1 + TOM], rescaled from μ(ρsl) to μ(sl_before) (with the heel-rise relation μ₅, by the
+//!   ratio of the two steps' blended F₂ scales) (the previous step's own F₂ and M, since
 //!   every step derives from the same prototype by the same multiplicative scalings) on its
 //!   ball/toe pivot one step back; on [TOM, 1] its ankle follows A and its angle F₃.
 //! - Knees: two-link inverse kinematics, knee forward. Where the data asks the hip to be higher
@@ -82,7 +83,23 @@ pub fn pose(w: &WalkData, mu: &MuFunctions, t: f64) -> Result<StepPose, Generate
     let tom = m.tom();
     let (swing_foot, w_angle, w_toe, w_floor) = if t < tom {
         // The previous step's F₂ and M tails: this step's, rescaled to μ(sl_before).
-        let kf = w.foot3().first()[0] / w.foot2().last()[0];
+        let kf = match (
+            mu.heel_rise_at(body, sb)?,
+            mu.heel_rise_at(body, w.step_length())?,
+        ) {
+            // With μ₅ the scale of F₂'s tail is a blend (phi): the previous step's tail is this
+            // one's times the ratio of the two blends, exactly −μ₅(sl_before) at t = 0 (where the
+            // previous step's stance foot left it) and −μ₃(sl_before) at TOM (where F₃ starts).
+            (Some(hb), Some(hs)) => {
+                let m3 = mu.mu_star()[2];
+                let h5 = mu.heel_rise().map_or(1.0, |h| h.star);
+                let ms = mu.values(body, w.step_length())?;
+                let s = super::phi::heel_blend(w.foot2(), t + 1.0);
+                ((1.0 - s) * hb / h5 + s * mb.foot_to / m3)
+                    / ((1.0 - s) * hs / h5 + s * ms.foot_to / m3)
+            }
+            _ => w.foot3().first()[0] / w.foot2().last()[0],
+        };
         let km = mb.meta_to / w.meta().last()[0];
         let f = w.foot2().at(t + 1.0) * kf;
         if t + 1.0 < m.mom() {
