@@ -797,6 +797,24 @@ mod tests {
     use crate::fit::forms::Fitting;
     use crate::relations::{Inputs, RunTflightSf};
 
+    /// A profiler over every sorted row (the tests' common source).
+    fn all_rows<'b>(
+        rel: &'b dyn Relation,
+        lay: &'b Layout,
+        sr: &'b SortedRows<'b>,
+        keys: &'b [f64],
+    ) -> Profiler<'b> {
+        Profiler {
+            rel,
+            lay,
+            src: Source::Sorted {
+                sr,
+                members: Members::All,
+                keys: DistinctKeys::new(keys),
+            },
+        }
+    }
+
     /// Flight times on a line with two jumps the free pieces cannot follow inside a piece: a
     /// small one at sf = 170 and a large one at sf = 196, so the profile of
     /// k1 has a local minimum at the small jump and its global minimum at the large one.
@@ -831,15 +849,7 @@ mod tests {
         let mut free = vec![true; 9];
         free[8] = false;
         let lay = Layout::new(rel, free, 3);
-        let pr = Profiler {
-            rel,
-            lay: &lay,
-            src: Source::Sorted {
-                sr: &sr,
-                members: Members::All,
-                keys: DistinctKeys::new(&keys),
-            },
-        };
+        let pr = all_rows(rel, &lay, &sr, &keys);
         let d = pr.discrete(7).expect("k1 is discrete");
         let mut p = published.coefficients().to_vec();
         p[8] = 250.0;
@@ -902,15 +912,7 @@ mod tests {
         let sr = SortedRows::new(form, &prep, true);
         let keys = sr.distinct_keys(&[true; 3]);
         let lay = Layout::new(rel, vec![true; 9], 3);
-        let pr = Profiler {
-            rel,
-            lay: &lay,
-            src: Source::Sorted {
-                sr: &sr,
-                members: Members::All,
-                keys: DistinctKeys::new(&keys),
-            },
-        };
+        let pr = all_rows(rel, &lay, &sr, &keys);
         let n = keys.len();
         let mut p = continuous.coefficients().to_vec();
         // (breakpoint, the other knot, search range)

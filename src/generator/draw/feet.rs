@@ -307,15 +307,8 @@ fn coords(p: &FootSample) -> [f64; 5] {
 
 #[cfg(test)]
 mod tests {
+    use super::super::foot::tests::sole;
     use super::*;
-
-    fn sole() -> Sole {
-        Sole {
-            heel: [-0.05, -0.08],
-            mtp: [0.14, -0.08],
-            toe: [0.19, -0.08],
-        }
-    }
 
     /// Two contacts 0.7 m apart joined by a 0.4 s flight whose sampled ankle arrives at the
     /// next heel moving (a collision the drawing has to smooth) and does not meet the rolling

@@ -266,10 +266,11 @@ fn heel_rocker(rho0: f64, rho_q: f64, t0: f64, ff: f64) -> [Key; 2] {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    fn sole() -> Sole {
+    /// The test foot shared by the drawing's tests.
+    pub(in crate::generator::draw) fn sole() -> Sole {
         // A 1.8 m figure's foot: heel 5 cm behind, metatarsals 14 cm ahead, toe tip 19 cm ahead
         // of the ankle, all 8 cm below it.
         Sole {

@@ -537,6 +537,12 @@ pub fn fit_heel_rise_slope<'a>(
     training: impl IntoIterator<Item = &'a MeasuredStride>,
 ) -> Option<f64> {
     let xy: Vec<(f64, f64)> = training.into_iter().map(heel_rise_sample).collect();
+    ols_slope(&xy)
+}
+
+/// The ordinary least-squares slope of y on x (with an intercept) over `xy`; `None` with fewer
+/// than 3 points or no spread of x.
+fn ols_slope(xy: &[(f64, f64)]) -> Option<f64> {
     let n = xy.len() as f64;
     if xy.len() < 3 {
         return None;
@@ -893,6 +899,23 @@ pub fn schreiber_strides_with(
 
 #[cfg(test)]
 mod tests {
+    /// α₅'s least squares against an independent computation: numpy.polyfit(x, y, 1)[0] and
+    /// scipy.stats.linregress(x, y).slope on these six points both give 0.860167483014695.
+    #[test]
+    fn the_heel_rise_slope_is_the_least_squares_slope() {
+        let x = [0.62, 0.71, 0.80, 0.85, 0.93, 1.02];
+        let y = [0.31, 0.38, 0.44, 0.52, 0.55, 0.66];
+        let xy: Vec<(f64, f64)> = x.into_iter().zip(y).collect();
+        let b = ols_slope(&xy).expect("a slope");
+        assert!((b - 0.860167483014695).abs() < 1e-12, "{b}");
+        assert_eq!(ols_slope(&xy[..2]), None, "two points");
+        assert_eq!(
+            ols_slope(&[(1.0, 0.2), (1.0, 0.3), (1.0, 0.4)]),
+            None,
+            "no spread"
+        );
+    }
+
     use super::*;
 
     /// Harrington et al. (2007): with the pelvis frame equal to the lab frame the hip joint
