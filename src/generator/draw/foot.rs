@@ -33,7 +33,8 @@ pub struct FootPose {
 }
 
 /// Half-width `δ` of the forefoot → toe rocker blend, rad: 0.15 rad, at most half of `θ₆max`
-/// (as the simulation's `walking::foot::toe_blend`).
+/// (the simulation's foot, `walking::foot`, uses this one too).
+#[inline]
 pub fn toe_blend(bend_max: f64) -> f64 {
     (0.5 * bend_max).min(0.15)
 }
@@ -225,19 +226,18 @@ pub fn stance_roll(
     let keys: Vec<Key> = match flat {
         None => piece(t0, t1, false, false),
         Some((ff, ho)) => {
-            let min = 1e-6;
             let mut keys = Vec::new();
-            if ff - t0 > min && samples[0].1 < 0.0 {
+            if ff - t0 > MIN_PHASE_S && samples[0].1 < 0.0 {
                 keys.extend(heel_rocker(samples[0].1, at(t0 + 0.25 * (ff - t0)), t0, ff));
-            } else if ff - t0 > min {
+            } else if ff - t0 > MIN_PHASE_S {
                 keys.extend(piece(t0, ff, false, true));
             } else {
                 keys.push(Key::rest(ff, 0.0));
             }
-            if ho - ff > min {
+            if ho - ff > MIN_PHASE_S {
                 keys.push(Key::rest(ho, 0.0));
             }
-            if t1 - ho > min {
+            if t1 - ho > MIN_PHASE_S {
                 keys.extend(piece(ho, t1, true, false).into_iter().skip(1));
             }
             keys
@@ -245,6 +245,10 @@ pub fn stance_roll(
     };
     C2Track::new(keys)
 }
+
+/// A contact's phase (heel rocker, foot flat, roll-off) shorter than this (s, far below one
+/// frame) is left out of the roll curve.
+const MIN_PHASE_S: f64 = 1e-6;
 
 /// The heel rocker's roll from `rho0 < 0` at `t0` (the heel strike) to rest at 0 at `ff` (foot
 /// flat): one quintic, never past 0 (the heel stays the pivot). Its starting rate is the

@@ -91,11 +91,8 @@ impl FootShape {
     }
 }
 
-/// Half-width `δ` of the forefoot → toe rocker blend, rad: 0.15 rad, at most half of `θ6max`.
-#[inline]
-pub fn toe_blend(theta6_max: f64) -> f64 {
-    (0.5 * theta6_max).min(0.15)
-}
+/// Half-width `δ` of the forefoot → toe rocker blend (one definition, the drawing layer's).
+pub use crate::generator::draw::foot::toe_blend;
 
 /// The toe segment's lift `ψ(x)` for `x = ρ − θ6max`: 0 for `x ≤ −δ`, `x` for `x ≥ δ`, the C¹
 /// quadratic `(x + δ)² / 4δ` between — always `≥ max(0, x)`, so `θ6 = ρ − ψ ≤ θ6max`.
